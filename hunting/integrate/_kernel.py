@@ -1,0 +1,527 @@
+"""The event-driven integration kernel for piecewise-smooth systems (numba, compiled once).
+
+One call integrates a :class:`~hunting.system.PiecewiseSystem` from ``t0`` towards ``t1``:
+adaptive steps of one method inside a mode, guards checked on every accepted step, the first
+crossing located on the step's dense output to near machine precision, the transition function
+applied, and integration restarted in the next mode. Outputs go to caller-owned buffers; the
+kernel returns at a step boundary with ``BUFFER_FULL`` when they are full so the caller can grow
+them and resume.
+
+Guards that are (nearly) zero when a segment starts -- the tangential departure from stick, a
+velocity that was just set to zero by a transition -- are *unarmed*: they are sampled on the
+dense output and armed once they have moved away from zero on the non-firing side. An unarmed
+guard that instead moves beyond ``guard_tol`` on the firing side fires at that threshold.
+"""
+import numba
+import numpy as np
+from numba import types
+
+from ..errors import Status
+from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE
+from ._steppers import (EPS, dense_eval, explicit_dense, explicit_step, numerical_jacobian,
+                        radau_dense, radau_step, select_initial_step)
+from ._tableau import METHOD_DOP853, METHOD_DP5, METHOD_RADAU
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+N_SAMPLES = 4          # interior samples of an unarmed guard per step
+ROOT_MAXITER = 200
+
+# info[] slots (int64)
+I_STATUS, I_NOUT, I_NEV, I_NSTEPS, I_NREJ, I_NFEV, I_MODE, I_STOPHITS, I_IEVAL, I_NJAC, I_NEVTOT = range(11)
+N_INFO = 11
+# finfo[] slots (float64)
+F_T, F_H = range(2)
+N_FINFO = 2
+
+_S_SUCCESS = int(Status.SUCCESS)
+_S_STOPPED = int(Status.STOPPED)
+_S_MAXSTEPS = int(Status.MAX_STEPS)
+_S_MAXEVENTS = int(Status.MAX_EVENTS)
+_S_ZENO = int(Status.ZENO)
+_S_SMALL = int(Status.STEP_TOO_SMALL)
+_S_NEWTON = int(Status.NEWTON_FAILED)
+_S_NONFINITE = int(Status.NON_FINITE)
+_S_FULL = int(Status.BUFFER_FULL)
+_S_INVALID = int(Status.INVALID_MODE)
+
+
+@numba.njit(cache=True)
+def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, gs):
+    dense_eval(method, t_old, h, y_old, Q, t, xs)
+    guards(mode, t, xs, p, gs)
+    return gs[i]
+
+
+@numba.njit(cache=True)
+def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, gs):
+    """Root of g_i(t) + shift on [ta, tb] given opposite signs at the ends (Illinois method
+    with bisection safeguard). Returns the right end of the final bracket: the first time at
+    which the guard is on its firing side, to within a few ulps of t."""
+    fa = ga + shift
+    fb = gb + shift
+    if fb == 0.0:
+        return tb
+    side = 0
+    for _ in range(ROOT_MAXITER):
+        width = tb - ta
+        if width <= 4.0 * EPS * max(abs(ta), abs(tb), 1e-300):
+            break
+        if fa != fb:
+            tc = (ta * fb - tb * fa) / (fb - fa)
+        else:
+            tc = 0.5 * (ta + tb)
+        if not (ta < tc < tb):
+            tc = 0.5 * (ta + tb)
+        fc = _guard_at(guards, mode, tc, t_old, h, y_old, Q, method, p, i, xs, gs) + shift
+        if fc == 0.0:
+            return tc
+        if (fc > 0.0) == (fb > 0.0):
+            tb = tc
+            fb = fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+        else:
+            ta = tc
+            fa = fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+    return tb
+
+
+@numba.njit(cache=True)
+def _armed_state(d, g, tol):
+    """Is a guard with direction d and value g away from zero on its non-firing side?"""
+    if d < 0:
+        return g > tol
+    if d > 0:
+        return g < -tol
+    return abs(g) > tol
+
+
+@numba.njit(cache=True)
+def _fires(d, ga, gb, shift_a_to_b):
+    """Does the guard cross zero (after shift) from a to b in its firing direction?"""
+    a = ga + shift_a_to_b
+    b = gb + shift_a_to_b
+    if d <= 0 and a > 0.0 and b <= 0.0:
+        return True
+    if d >= 0 and a < 0.0 and b >= 0.0:
+        return True
+    return False
+
+
+@numba.njit(cache=True)
+def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, gs):
+    """Scan an unarmed guard over one step. Returns (event time or inf, armed at the end);
+    an event found while still unarmed is a threshold event (armed False)."""
+    ta = t
+    ga = g0
+    armed = False
+    for k in range(1, N_SAMPLES + 2):
+        if k == N_SAMPLES + 1:
+            tb = t_new
+            gb = g1
+        else:
+            tb = t + h * k / (N_SAMPLES + 1)
+            gb = _guard_at(guards, mode, tb, t, h, y_old, Q, method, p, i, xs, gs)
+        if armed:
+            if _fires(d, ga, gb, 0.0):
+                return locate_root(guards, mode, i, 0.0, ta, ga, tb, gb, t, h, y_old, Q, method, p,
+                                   xs, gs), True
+        else:
+            # beyond the tolerance band on the firing side: fire at the band's edge
+            if d <= 0 and gb < -tol and ga + tol >= 0.0:
+                return locate_root(guards, mode, i, tol, ta, ga, tb, gb, t, h, y_old, Q, method, p,
+                                   xs, gs), False
+            if d >= 0 and gb > tol and ga - tol <= 0.0:
+                return locate_root(guards, mode, i, -tol, ta, ga, tb, gb, t, h, y_old, Q, method, p,
+                                   xs, gs), False
+            if _armed_state(d, gb, tol):
+                armed = True
+        ta = tb
+        ga = gb
+    return np.inf, armed
+
+
+@numba.njit(cache=True)
+def _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
+             y_new, f_new, err):
+    """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
+    if method == METHOD_RADAU:
+        en, conv, fe = radau_step(vf, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
+                                  R, ytmp, y_new, f_new, err)
+        return conv, fe
+    explicit_step(method, vf, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new, f_new, err)
+    return True, 12 if method == METHOD_DOP853 else 6
+
+
+@numba.njit(cache=True)
+def _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol, J, M, piv, Mr,
+                  pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, gs):
+    """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
+    On success xs holds the state at the returned event time; otherwise xs is left as the
+    dense-output state and t_ev is returned unchanged. Returns (t_ev, f evaluations)."""
+    n = x.size
+    delta = 1e-7 * h
+    ta = max(t, t_ev - delta)
+    tb = min(t + h, t_ev + delta)
+    ga = _guard_at(guards, mode, ta, t, h, x, Q, method, p, i_ev, ytmp, gs)
+    gb = _guard_at(guards, mode, tb, t, h, x, Q, method, p, i_ev, ytmp, gs)
+    if tb <= ta or ga == gb:
+        return t_ev, 0
+    slope = (gb - ga) / (tb - ta)
+    he = t_ev - t
+    nfev = 0
+    for it in range(4):
+        ok, fe = _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
+                          R, K, ytmp, y_new, f_new, err)
+        nfev += fe
+        if not ok:
+            return t_ev, nfev
+        guards(mode, t + he, y_new, p, gs)
+        dh = -gs[i_ev] / slope
+        if abs(dh) <= 4.0 * EPS * max(abs(t + he), 1e-300) or it == 3:
+            break
+        he_new = he + dh
+        if not (0.0 < he_new <= h) or abs(dh) > 1e-3 * h + abs(t_ev - t - he) * 10.0 + 1e-12 * h:
+            break
+        he = he_new
+    for i in range(n):
+        xs[i] = y_new[i]
+    return t + he, nfev
+
+
+KERNEL_SIG = types.void(
+    VF_TYPE, GUARD_TYPE, RESET_TYPE, JAC_TYPE, MODE_TYPE, types.boolean, types.int64,
+    types.float64, types.float64, types.float64[::1], types.int64, types.float64[::1],
+    types.int64[:, ::1],
+    types.float64, types.float64, types.float64, types.float64, types.int64, types.int64,
+    types.float64, types.boolean,
+    types.float64[::1], types.boolean, types.int64, types.int64, types.int64, types.float64,
+    types.float64[::1], types.float64[:, ::1], types.int64[::1],
+    types.float64[::1], types.float64[:, ::1], types.float64[:, ::1], types.int64[::1],
+    types.int64[::1], types.int64[::1],
+    types.int64[::1], types.float64[::1], types.float64[::1],
+)
+
+
+@numba.njit(KERNEL_SIG, cache=True)
+def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
+                     t0, t1, x0, mode0, p, directions,
+                     rtol, atol, h0, hmax, max_steps, max_events, guard_tol, fixed,
+                     t_eval, record_steps, stop_mode, stop_count, zeno_count, zeno_window,
+                     out_t, out_x, out_mode,
+                     ev_t, ev_xb, ev_xa, ev_guard, ev_from, ev_to,
+                     info, finfo, x_final):
+    """Integrate from (t0, x0, mode0) towards t1; see the module docstring.
+
+    Inputs: ``mode0 < 0`` asks ``mode_of``; ``h0 <= 0`` selects the first step; ``fixed``
+    takes steps of h0 without error control (convergence studies; rtol/atol then only set the
+    Newton tolerance of the implicit method); ``t_eval``
+    (sorted, within [t0, t1]) or, when empty, every accepted step and both sides of each event
+    are recorded if ``record_steps``. ``stop_mode >= 0`` stops on the ``stop_count``-th entry
+    into that mode (counted from ``info[I_STOPHITS]``). ``info[I_IEVAL]`` is the next t_eval
+    index, ``info[I_NEVTOT]`` the events so far (both carried across resumes).
+
+    Outputs: info (status, counts, final mode), finfo (final t, last step), x_final, and the
+    buffers out_* (points) and ev_* (event time, state before/after, guard, modes)."""
+    n = x0.size
+    n_modes = directions.shape[0]
+    ng = directions.shape[1]
+    cap_out = out_t.size
+    cap_ev = ev_t.size
+    n_eval = t_eval.size
+    use_eval = n_eval > 0
+
+    x = x0.copy()
+    t = t0
+    mode = mode0
+    if mode < 0:
+        mode = mode_of(t, x, p)
+    if mode < 0 or mode >= n_modes:
+        info[I_STATUS] = _S_INVALID
+        info[I_MODE] = mode
+        finfo[F_T] = t
+        x_final[:] = x
+        return
+
+    f = np.empty(n)
+    y_new = np.empty(n)
+    f_new = np.empty(n)
+    ytmp = np.empty(n)
+    ftmp = np.empty(n)
+    err = np.empty(n)
+    xs = np.empty(n)
+    K = np.empty((16, n))
+    Q = np.zeros((7, n))
+    J = np.empty((n, n))
+    M = np.empty((3 * n, 3 * n))
+    piv = np.empty(3 * n, dtype=np.int64)
+    Mr = np.empty((n, n))
+    pivr = np.empty(n, dtype=np.int64)
+    Z = np.empty((3, n))
+    F3 = np.empty((3, n))
+    R = np.empty(3 * n)
+    g_old = np.empty(ng)
+    g_new = np.empty(ng)
+    gs = np.empty(ng)
+    armed = np.zeros(ng, dtype=np.bool_)
+    zeno_times = np.full(max(zeno_count, 1), -np.inf)
+    # last error-controlled step size per mode: re-entering a mode starts from it instead of
+    # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
+    h_mode = np.full(n_modes, np.inf)
+
+    n_out = info[I_NOUT]
+    n_ev = info[I_NEV]
+    n_ev_total = info[I_NEVTOT]
+    stop_hits = info[I_STOPHITS]
+    i_eval = info[I_IEVAL]
+    n_steps = 0
+    n_rej = 0
+    nfev = 0
+    njac = 0
+    order = 8 if method == METHOD_DOP853 else 5
+    expo = -1.0 / 8.0 if method == METHOD_DOP853 else (-1.0 / 5.0 if method == METHOD_DP5 else -0.25)
+    status = _S_SUCCESS
+
+    vf(mode, t, x, p, f)
+    nfev += 1
+    guards(mode, t, x, p, g_old)
+    for i in range(ng):
+        armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
+
+    if record_steps and not use_eval and n_out == 0:
+        out_t[0] = t
+        out_x[0, :] = x
+        out_mode[0] = mode
+        n_out = 1
+    while use_eval and i_eval < n_eval and t_eval[i_eval] <= t:
+        if t_eval[i_eval] == t:
+            out_t[n_out] = t
+            out_x[n_out, :] = x
+            out_mode[n_out] = mode
+            n_out += 1
+        i_eval += 1
+
+    if h0 > 0.0:
+        h = h0
+    else:
+        h = select_initial_step(vf, mode, t, x, f, p, max(t1 - t, 1e-300), order, rtol, atol, ytmp, ftmp)
+        nfev += 1
+    n_small = 0
+    while True:
+        remaining = t1 - t
+        if remaining <= 0.0:
+            status = _S_SUCCESS
+            break
+        if n_steps + n_rej >= max_steps:
+            status = _S_MAXSTEPS
+            break
+        if (not use_eval) and record_steps and cap_out - n_out < 3:
+            status = _S_FULL
+            break
+        if n_ev >= cap_ev:
+            status = _S_FULL
+            break
+        tiny = 8.0 * EPS * max(abs(t), 1e-300)
+        if h > hmax:
+            h = hmax
+        last = False
+        if h >= remaining - tiny:
+            h = remaining
+            last = True
+        if h <= tiny and not last:
+            status = _S_SMALL
+            break
+        if method == METHOD_RADAU:
+            if has_jac:
+                jac(mode, t, x, p, J)
+            else:
+                numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
+                nfev += n
+            njac += 1
+            en, conv, fe = radau_step(vf, mode, t, x, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z,
+                                      F3, R, ytmp, y_new, f_new, err)
+            nfev += fe
+            if not conv:
+                n_rej += 1
+                h *= 0.5
+                if h <= tiny:
+                    status = _S_NEWTON
+                    break
+                continue
+        else:
+            en = explicit_step(method, vf, mode, t, x, f, h, p, rtol, atol, K, ytmp, y_new, f_new, err)
+            nfev += 12 if method == METHOD_DOP853 else 6
+        finite = np.isfinite(en)
+        for i in range(n):
+            if not np.isfinite(y_new[i]) or not np.isfinite(f_new[i]):
+                finite = False
+        if not finite:
+            n_rej += 1
+            n_small += 1
+            h *= 0.25
+            if h <= tiny or n_small > 60:
+                status = _S_NONFINITE
+                break
+            continue
+        if fixed:
+            en = 0.0
+        if en > 1.0:
+            n_rej += 1
+            h *= max(MIN_FACTOR, SAFETY * en ** expo)
+            if h <= tiny:
+                status = _S_SMALL
+                break
+            continue
+        n_small = 0
+        n_steps += 1
+        t_new = t1 if last else t + h
+        if method == METHOD_RADAU:
+            radau_dense(Z, Q)
+        else:
+            nfev += explicit_dense(method, vf, mode, t, x, y_new, f_new, h, p, K, ytmp, Q)
+
+        # ---- events on this step
+        guards(mode, t_new, y_new, p, g_new)
+        t_ev = np.inf
+        i_ev = -1
+        ev_exact = True   # False for threshold events of unarmed guards (no polishing)
+        for i in range(ng):
+            d = directions[mode, i]
+            if armed[i]:
+                if _fires(d, g_old[i], g_new[i], 0.0):
+                    tr = locate_root(guards, mode, i, 0.0, t, g_old[i], t_new, g_new[i], t, h, x, Q,
+                                     method, p, xs, gs)
+                    if tr < t_ev:
+                        t_ev = tr
+                        i_ev = i
+                        ev_exact = True
+            else:
+                tr, arm_end = _scan_unarmed(guards, mode, i, d, guard_tol, t, g_old[i], t_new,
+                                            g_new[i], h, x, Q, method, p, xs, gs)
+                if tr < t_ev:
+                    t_ev = tr
+                    i_ev = i
+                    ev_exact = arm_end
+                armed[i] = arm_end
+        if i_ev >= 0:
+            # output up to the event
+            while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_ev:
+                dense_eval(method, t, h, x, Q, t_eval[i_eval], xs)
+                out_t[n_out] = t_eval[i_eval]
+                out_x[n_out, :] = xs
+                out_mode[n_out] = mode
+                n_out += 1
+                i_eval += 1
+            dense_eval(method, t, h, x, Q, t_ev, xs)
+            if ev_exact and t_ev > t:
+                # polish: integrate to the event with one step of the method itself, so the
+                # event state has the method's order rather than its dense output's
+                t_ev, fe = _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol,
+                                         atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new,
+                                         err, Q, xs, gs)
+                nfev += fe
+            new_mode = reset(mode, i_ev, t_ev, xs, p, ytmp)
+            ev_t[n_ev] = t_ev
+            ev_xb[n_ev, :] = xs
+            ev_xa[n_ev, :] = ytmp
+            ev_guard[n_ev] = i_ev
+            ev_from[n_ev] = mode
+            ev_to[n_ev] = new_mode
+            n_ev += 1
+            n_ev_total += 1
+            if record_steps and not use_eval:
+                out_t[n_out] = t_ev
+                out_x[n_out, :] = xs
+                out_mode[n_out] = mode
+                n_out += 1
+            t = t_ev
+            for i in range(n):
+                x[i] = ytmp[i]
+            if new_mode < 0:
+                status = _S_STOPPED
+                break
+            if new_mode >= n_modes:
+                status = _S_INVALID
+                mode = new_mode
+                break
+            mode = new_mode
+            if record_steps and not use_eval:
+                out_t[n_out] = t
+                out_x[n_out, :] = x
+                out_mode[n_out] = mode
+                n_out += 1
+            # Zeno: zeno_count events within zeno_window
+            if zeno_count > 0:
+                k = n_ev_total % zeno_count
+                if t - zeno_times[k] < zeno_window:
+                    status = _S_ZENO
+                    break
+                zeno_times[k] = t
+            if stop_mode >= 0 and mode == stop_mode:
+                stop_hits += 1
+                if stop_hits >= stop_count:
+                    status = _S_STOPPED
+                    break
+            if n_ev_total >= max_events:
+                status = _S_MAXEVENTS
+                break
+            vf(mode, t, x, p, f)
+            nfev += 1
+            guards(mode, t, x, p, g_old)
+            for i in range(ng):
+                armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
+            if fixed:
+                h = h0
+            else:
+                h = min(h, h_mode[mode])
+            continue
+        # ---- no event: accept the whole step
+        while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new:
+            dense_eval(method, t, h, x, Q, t_eval[i_eval], xs)
+            out_t[n_out] = t_eval[i_eval]
+            out_x[n_out, :] = xs
+            out_mode[n_out] = mode
+            n_out += 1
+            i_eval += 1
+        t = t_new
+        for i in range(n):
+            x[i] = y_new[i]
+            f[i] = f_new[i]
+        for i in range(ng):
+            g_old[i] = g_new[i]
+        if record_steps and not use_eval:
+            out_t[n_out] = t
+            out_x[n_out, :] = x
+            out_mode[n_out] = mode
+            n_out += 1
+        if last:
+            status = _S_SUCCESS
+            break
+        if fixed:
+            h = h0
+        elif en == 0.0:
+            h *= MAX_FACTOR
+        else:
+            h *= min(MAX_FACTOR, SAFETY * en ** expo)
+            h_mode[mode] = h
+
+    info[I_STATUS] = status
+    info[I_NOUT] = n_out
+    info[I_NEV] = n_ev
+    info[I_NSTEPS] += n_steps
+    info[I_NREJ] += n_rej
+    info[I_NFEV] += nfev
+    info[I_MODE] = mode
+    info[I_STOPHITS] = stop_hits
+    info[I_IEVAL] = i_eval
+    info[I_NJAC] += njac
+    info[I_NEVTOT] = n_ev_total
+    finfo[F_T] = t
+    finfo[F_H] = h
+    x_final[:] = x

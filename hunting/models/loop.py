@@ -1,0 +1,100 @@
+"""``ServoLoop``: plant + friction + PID assembled into a compiled closed loop."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from ..errors import SystemDefinitionError
+from ..system import PiecewiseSystem
+from . import servo as S
+from .controller import PID
+from .friction import LuGre, Switch
+from .plant import Plant
+
+
+@dataclass(frozen=True)
+class ServoLoop:
+    """A PID-controlled mass with friction (thesis eqs. 8.1-8.2, 9.2, 10.1).
+
+    plant : Plant; friction : Switch or LuGre; controller : PID; name : label; units : names of
+    the position and force units (e.g. {"q": "m", "F": "N"} or {"q": "rad", "F": "N m"})."""
+
+    plant: Plant
+    friction: object
+    controller: PID
+    name: str = "servo"
+    units: dict = field(default_factory=lambda: {"q": "m", "F": "N", "u": "V"})
+
+    def __post_init__(self):
+        if not isinstance(self.plant, Plant):
+            raise SystemDefinitionError(f"plant = {self.plant!r} must be a hunting.models.Plant")
+        if not isinstance(self.friction, (Switch, LuGre)):
+            raise SystemDefinitionError(f"friction = {self.friction!r} must be a Switch or LuGre model")
+        if not isinstance(self.controller, PID):
+            raise SystemDefinitionError(f"controller = {self.controller!r} must be a hunting.models.PID")
+
+    @property
+    def model_code(self) -> int:
+        if isinstance(self.friction, LuGre):
+            return S.MODEL_LUGRE
+        return S.MODEL_BANDED if self.friction.variant == "banded" else S.MODEL_SWITCH
+
+    def param_array(self) -> np.ndarray:
+        """The flat parameter array in the layout of :mod:`hunting.models.servo`."""
+        p = np.zeros(S.COG)
+        pl, c, fr = self.plant, self.controller, self.friction
+        p[[S.M, S.CM, S.KP, S.KD, S.KI, S.QD]] = [pl.mass, pl.motor_constant, c.kp, c.kd, c.ki, pl.setpoint]
+        p[[S.FEXT_KIND, S.FEXT_AMP, S.FEXT_PERIOD]] = pl.external_force_encoded()
+        p[S.MODEL] = self.model_code
+        p[S.POS:S.POS + 5] = fr.curve.positive.encoded()
+        p[S.NEG:S.NEG + 5] = fr.curve.negative.encoded()
+        if isinstance(fr, Switch):
+            p[S.ETA], p[S.ALPHA] = fr.eta, fr.alpha
+        else:
+            p[S.SIGMA0], p[S.SIGMA1] = fr.sigma0, fr.sigma1
+            p[S.VD] = 0.0 if math.isinf(fr.vd) else fr.vd
+        return np.concatenate([p, self.plant.cogging_encoded()])
+
+    @property
+    def odd(self) -> bool:
+        """True when the loop is odd in x (symmetric friction, no cogging, no external force)."""
+        return (self.friction.curve.symmetric and self.plant.cogging is None
+                and self.plant.external_force is None)
+
+    @cached_property
+    def system(self) -> PiecewiseSystem:
+        q, F = self.units.get("q", "m"), self.units.get("F", "N")
+        units = {"x1": q, "x2": f"{q}/s", "x3": f"{q} s", "x4": q, "F": F}
+        return S.build_servo_system(self.name, self.param_array(), odd=self.odd, units=units)
+
+    @property
+    def n_states(self) -> int:
+        return 4 if self.model_code == S.MODEL_LUGRE else 3
+
+    @property
+    def stick_mode(self) -> int | None:
+        """Index of the exact stick mode (Switch, variant filippov), else None."""
+        return S.STICK if self.model_code == S.MODEL_SWITCH else None
+
+    def state(self, x1: float = 0.0, x2: float = 0.0, x3: float = 0.0, z: float = 0.0) -> np.ndarray:
+        """A state vector of the right size (z only for LuGre)."""
+        return np.array([x1, x2, x3, z][: self.n_states], dtype=float)
+
+    def nonfriction_force(self, x, t: float = 0.0) -> float:
+        """F_nf = cm u + f_ext - F_cog at state x [force unit]."""
+        return float(S.nonfriction_force(float(t), self.system.check_state(x, "x"), self.system.params))
+
+    def equilibrium_set(self) -> tuple[float, float]:
+        """Bounds of x3 on the equilibrium set x1 = x2 = 0 (Switch: cm ki |x3| within the stick
+        set shifted by the cogging force at q_d) [x3 unit]."""
+        lo, hi = self.friction.stick_set
+        cm, ki = self.plant.motor_constant, self.controller.ki
+        fcog = 0.0 if self.plant.cogging is None else float(self.plant.cogging(self.plant.setpoint)[0])
+        if cm * ki == 0:
+            raise SystemDefinitionError("the equilibrium set needs integral action (ki != 0)")
+        # F_nf = -cm ki x3 - F_cog(q_d) must lie in [lo, hi]
+        a, b = (-(hi + fcog) / (cm * ki), -(lo + fcog) / (cm * ki))
+        return (min(a, b), max(a, b))
