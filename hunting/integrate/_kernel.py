@@ -274,6 +274,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     # last error-controlled step size per mode: re-entering a mode starts from it instead of
     # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
     h_mode = np.full(n_modes, np.inf)
+    n_threshold = 0   # consecutive events of guards that never left their tolerance band
 
     n_out = info[I_NOUT]
     n_ev = info[I_NEV]
@@ -456,7 +457,12 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
                 out_x[n_out, :] = x
                 out_mode[n_out] = mode
                 n_out += 1
-            # Zeno: zeno_count events within zeno_window
+            # Zeno: zeno_count events within zeno_window, or zeno_count consecutive events of
+            # guards that never armed (the motion chatters inside the guard tolerance)
+            n_threshold = 0 if ev_exact else n_threshold + 1
+            if zeno_count > 0 and n_threshold >= zeno_count:
+                status = _S_ZENO
+                break
             if zeno_count > 0:
                 k = n_ev_total % zeno_count
                 if t - zeno_times[k] < zeno_window:
