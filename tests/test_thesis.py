@@ -72,5 +72,8 @@ def test_banded_switch_converges_to_exact_filippov(beta, final_err):
 
 def test_demo_main_job_passes(tmp_path):
     assert run_demo(tmp_path) == 0
-    for name in ("fig9_4.png", "fig8_2_switch.png", "fig8_2_lugre.png", "fig4_2.png", "demo.json"):
-        assert (tmp_path / name).stat().st_size > 1000
+    for name in ("fig9_4.png", "fig8_2_switch.png", "fig8_2_lugre.png", "fig4_2.png"):
+        assert (tmp_path / name).stat().st_size > 10000
+    import json
+    rows = json.loads((tmp_path / "demo.json").read_text())
+    assert len(rows) == 4 and all(r["ok"] for r in rows)
