@@ -51,7 +51,7 @@ JAC_TYPE = types.FunctionType(JAC_SIG)
 MODE_KINDS = ("smooth", "stick", "filippov")
 
 
-@numba.njit(JAC_SIG, cache=True)
+@numba.njit(JAC_SIG, cache=True, error_model="numpy")
 def no_jacobian(mode, t, x, p, out):  # pragma: no cover - placeholder passed when finite differences are used
     """Stand-in for systems without an analytic Jacobian (the kernels then use differences)."""
     out[:, :] = 0.0
@@ -83,11 +83,11 @@ def _check_dispatcher(role: str, fn, sig) -> None:
     sigs = getattr(fn, "signatures", None)
     if sigs is None:
         raise SystemDefinitionError(
-            f"{role} = {fn!r} is not a numba function: decorate it with @numba.njit(hunting.{role.upper()}_SIG, cache=True)")
+            f"{role} = {fn!r} is not a numba function: decorate it with @numba.njit(hunting.{role.upper()}_SIG, cache=True, error_model='numpy')")
     if sig.args not in [tuple(s) for s in sigs]:
         raise SystemDefinitionError(
             f"{role} {getattr(fn, '__name__', fn)!r} was compiled for {sigs}, not for {sig}: "
-            f"decorate it with an explicit signature, @numba.njit(hunting.system.<SIG>, cache=True)")
+            f"decorate it with an explicit signature, @numba.njit(hunting.system.<SIG>, cache=True, error_model='numpy')")
 
 
 @dataclass(frozen=True)

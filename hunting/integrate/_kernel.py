@@ -47,14 +47,14 @@ _S_FULL = int(Status.BUFFER_FULL)
 _S_INVALID = int(Status.INVALID_MODE)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, gs):
     dense_eval(method, t_old, h, y_old, Q, t, xs)
     guards(mode, t, xs, p, gs)
     return gs[i]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, gs):
     """Root of g_i(t) + shift on [ta, tb] given opposite signs at the ends (Illinois method
     with bisection safeguard). Returns the right end of the final bracket: the first time at
@@ -92,7 +92,7 @@ def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, meth
     return tb
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _armed_state(d, g, tol):
     """Is a guard with direction d and value g away from zero on its non-firing side?"""
     if d < 0:
@@ -102,7 +102,7 @@ def _armed_state(d, g, tol):
     return abs(g) > tol
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _fires(d, ga, gb, shift_a_to_b):
     """Does the guard cross zero (after shift) from a to b in its firing direction?"""
     a = ga + shift_a_to_b
@@ -114,7 +114,7 @@ def _fires(d, ga, gb, shift_a_to_b):
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, gs):
     """Scan an unarmed guard over one step. Returns (event time or inf, armed at the end);
     an event found while still unarmed is a threshold event (armed False)."""
@@ -147,7 +147,7 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
     return np.inf, armed
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
              y_new, f_new, err):
     """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
@@ -159,7 +159,7 @@ def _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, 
     return True, 12 if method == METHOD_DOP853 else 6
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol, J, M, piv, Mr,
                   pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, gs):
     """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
@@ -209,7 +209,7 @@ KERNEL_SIG = types.void(
 )
 
 
-@numba.njit(KERNEL_SIG, cache=True)
+@numba.njit(KERNEL_SIG, cache=True, error_model="numpy")
 def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
                      t0, t1, x0, mode0, p, directions,
                      rtol, atol, h0, hmax, max_steps, max_events, guard_tol, fixed,
@@ -314,6 +314,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
         h = select_initial_step(vf, mode, t, x, f, p, max(t1 - t, 1e-300), order, rtol, atol, ytmp, ftmp)
         nfev += 1
     n_small = 0
+    rejected = False
     while True:
         remaining = t1 - t
         if remaining <= 0.0:
@@ -374,6 +375,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
             en = 0.0
         if en > 1.0:
             n_rej += 1
+            rejected = True
             h *= max(MIN_FACTOR, SAFETY * en ** expo)
             if h <= tiny:
                 status = _S_SMALL
@@ -382,13 +384,16 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
         n_small = 0
         n_steps += 1
         t_new = t1 if last else t + h
+        # ---- events on this step; dense output only when a guard or t_eval needs it
+        guards(mode, t_new, y_new, p, g_new)
+        need_dense = use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new
+        for i in range(ng):
+            if (not armed[i]) or _fires(directions[mode, i], g_old[i], g_new[i], 0.0):
+                need_dense = True
         if method == METHOD_RADAU:
             radau_dense(Z, Q)
-        else:
+        elif need_dense:
             nfev += explicit_dense(method, vf, mode, t, x, y_new, f_new, h, p, K, ytmp, Q)
-
-        # ---- events on this step
-        guards(mode, t_new, y_new, p, g_new)
         t_ev = np.inf
         i_ev = -1
         ev_exact = True   # False for threshold events of unarmed guards (no polishing)
@@ -512,10 +517,11 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
         if fixed:
             h = h0
         elif en == 0.0:
-            h *= MAX_FACTOR
+            h *= 1.0 if rejected else MAX_FACTOR
         else:
-            h *= min(MAX_FACTOR, SAFETY * en ** expo)
+            h *= min(1.0 if rejected else MAX_FACTOR, SAFETY * en ** expo)
             h_mode[mode] = h
+        rejected = False
 
     info[I_STATUS] = status
     info[I_NOUT] = n_out

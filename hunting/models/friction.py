@@ -24,10 +24,14 @@ from ..errors import SystemDefinitionError, check_finite, check_finite_positive
 BETA_DISCONTINUOUS = 0.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def pow_ext(r, beta):
     """|r|^beta for r >= 0, extended smoothly a little past r = 0 (used near events): the
     analytic continuation r^beta for integer beta, 0 for r < 0 otherwise."""
+    if beta == 2.0:          # the common case; pow() costs several times a multiply
+        return r * r
+    if beta == 1.0:
+        return r
     if r >= 0.0:
         return r ** beta
     if beta == math.floor(beta):
@@ -35,7 +39,7 @@ def pow_ext(r, beta):
     return 0.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def stribeck_level(vrel, Fc, Fs, vs, beta):
     """Stribeck level g for relative speed ``vrel`` (>= 0 in slip), without viscous part [N].
 
@@ -45,13 +49,13 @@ def stribeck_level(vrel, Fc, Fs, vs, beta):
     return Fc + (Fs - Fc) * math.exp(-pow_ext(vrel / vs, beta))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def slip_force(v, s, Fc, Fs, vs, beta, b):
     """Friction force in slip with direction s = +1 / -1 (taken from the mode): s g(s v) + b v."""
     return s * stribeck_level(s * v, Fc, Fs, vs, beta) + b * v
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _slip_force_array(v, Fc_p, Fs_p, vs_p, beta_p, b_p, Fc_n, Fs_n, vs_n, beta_n, b_n, out):
     for k in range(v.size):
         if v[k] > 0:
@@ -197,7 +201,7 @@ class Switch:
         return self.curve.stick_set
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def lugre_rates(v, z, s, Fc, Fs, vs, beta, b, sigma0, sigma1, vd):
     """LuGre bristle rate and force for velocity v, bristle state z, direction s (= sign of v
     from the mode). Returns (dz/dt [m/s], friction force [N]).

@@ -14,7 +14,7 @@ COG_NONE, COG_HARMONIC, COG_TABLE = 0, 1, 2
 FEXT_NONE, FEXT_CONSTANT, FEXT_TRIANGLE = 0, 1, 2
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def cogging_force(q, p, base):
     """Cogging force F_cog(q) [N] from the flat parameter array, block starting at ``base``:
     [kind, n, L, data...]; harmonic: F = sum_k a_k cos(2 pi k q / L) + b_k sin(2 pi k q / L),
@@ -50,7 +50,7 @@ def cogging_force(q, p, base):
     return (1.0 - w1) * p[d + n + lo] + w1 * p[d + n + hi]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def external_force(t, kind, amplitude, period):
     """Known external force [N]: none, constant, or a triangle wave that starts at 0, rises to
     +amplitude at period/4, falls to -amplitude at 3 period/4 and returns to 0 at period."""

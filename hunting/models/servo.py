@@ -47,7 +47,7 @@ BAND_SLIP, BAND_STICK, BAND_TRANSITION = 0, 1, 2  # switch-banded
 V_POS, V_NEG = 0, 1                               # lugre
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def nonfriction_force(t, x, p):
     """F_nf = cm u + f_ext(t) - F_cog(q) [N]: every force on the mass except friction."""
     u = -(p[KP] * x[0] + p[KD] * x[1] + p[KI] * x[2])
@@ -55,13 +55,13 @@ def nonfriction_force(t, x, p):
         - cogging_force(x[0] + p[QD], p, COG)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def _slip(v, s, p):
     base = POS if s > 0 else NEG
     return slip_force(v, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4])
 
 
-@numba.njit(VF_SIG, cache=True)
+@numba.njit(VF_SIG, cache=True, error_model="numpy")
 def servo_vf(mode, t, x, p, out):
     model = p[MODEL]
     F = nonfriction_force(t, x, p)
@@ -97,7 +97,7 @@ def servo_vf(mode, t, x, p, out):
         out[3] = zdot
 
 
-@numba.njit(GUARD_SIG, cache=True)
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy")
 def servo_guards(mode, t, x, p, out):
     model = p[MODEL]
     if model == MODEL_SWITCH:
@@ -126,7 +126,7 @@ def servo_guards(mode, t, x, p, out):
         out[1] = 1.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _switch_mode_at_rest(t, x, p):
     d = direction_from_rest(nonfriction_force(t, x, p), p[POS + 1], p[NEG + 1])
     if d > 0:
@@ -136,7 +136,7 @@ def _switch_mode_at_rest(t, x, p):
     return STICK
 
 
-@numba.njit(RESET_SIG, cache=True)
+@numba.njit(RESET_SIG, cache=True, error_model="numpy")
 def servo_reset(mode, guard, t, x, p, x_out):
     for i in range(x.size):
         x_out[i] = x[i]
@@ -157,7 +157,7 @@ def servo_reset(mode, guard, t, x, p, x_out):
     return V_NEG if mode == V_POS else V_POS
 
 
-@numba.njit(MODE_SIG, cache=True)
+@numba.njit(MODE_SIG, cache=True, error_model="numpy")
 def servo_mode_of(t, x, p):
     model = p[MODEL]
     if model == MODEL_SWITCH:
