@@ -13,13 +13,13 @@ from hunting.sliding import direction_from_rest, filippov_attractive, filippov_c
 SLIP_POS, SLIP_NEG, STICK = 0, 1, 2
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def spring_force(t, x, p):
     """Every force on mass 1 except friction."""
     return p[2] * (x[2] - x[0]) + p[3] * (x[3] - x[1])
 
 
-@numba.njit(VF_SIG, cache=True)
+@numba.njit(VF_SIG, cache=True, error_model="numpy")
 def two_mass_vf(mode, t, x, p, out):
     F1 = spring_force(t, x, p)
     out[2] = x[3]
@@ -33,7 +33,7 @@ def two_mass_vf(mode, t, x, p, out):
         out[1] = (F1 - s * p[4]) / p[0]
 
 
-@numba.njit(GUARD_SIG, cache=True)
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy")
 def two_mass_guards(mode, t, x, p, out):
     if mode == STICK:
         F1 = spring_force(t, x, p)
@@ -44,13 +44,13 @@ def two_mass_guards(mode, t, x, p, out):
         out[1] = 1.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _rest_mode(t, x, p):
     d = direction_from_rest(spring_force(t, x, p), p[5], p[5])
     return SLIP_POS if d > 0 else (SLIP_NEG if d < 0 else STICK)
 
 
-@numba.njit(RESET_SIG, cache=True)
+@numba.njit(RESET_SIG, cache=True, error_model="numpy")
 def two_mass_reset(mode, guard, t, x, p, x_out):
     x_out[:] = x
     if mode == STICK:
@@ -59,7 +59,7 @@ def two_mass_reset(mode, guard, t, x, p, x_out):
     return _rest_mode(t, x_out, p)
 
 
-@numba.njit(MODE_SIG, cache=True)
+@numba.njit(MODE_SIG, cache=True, error_model="numpy")
 def two_mass_mode(t, x, p):
     if x[1] != 0.0:
         return SLIP_POS if x[1] > 0 else SLIP_NEG
@@ -82,7 +82,7 @@ def two_mass_system(m1=1.0, m2=0.5, k=50.0, c=0.2, Fc=1.0, Fs=1.5, A=2.0, w=3.0)
 BELOW, ABOVE, SLIDE = 0, 1, 2
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _fields(x, fm, fp):
     a = 2.0 * math.sin(x[1])
     fm[0] = 1.0 + a
@@ -91,7 +91,7 @@ def _fields(x, fm, fp):
     fp[1] = 1.0
 
 
-@numba.njit(VF_SIG, cache=True)
+@numba.njit(VF_SIG, cache=True, error_model="numpy")
 def filippov_vf(mode, t, x, p, out):
     fm = np.empty(2)
     fp = np.empty(2)
@@ -104,7 +104,7 @@ def filippov_vf(mode, t, x, p, out):
         filippov_combine(fm, fp, filippov_weight(fm[0], fp[0]), out)
 
 
-@numba.njit(GUARD_SIG, cache=True)
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy")
 def filippov_guards(mode, t, x, p, out):
     if mode == SLIDE:
         a = 2.0 * math.sin(x[1])
@@ -115,7 +115,7 @@ def filippov_guards(mode, t, x, p, out):
         out[1] = 1.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy")
 def _surface_mode(x):
     a = 2.0 * math.sin(x[1])
     if filippov_attractive(1.0 + a, -1.0 + a):
@@ -123,7 +123,7 @@ def _surface_mode(x):
     return ABOVE if -1.0 + a > 0 else BELOW
 
 
-@numba.njit(RESET_SIG, cache=True)
+@numba.njit(RESET_SIG, cache=True, error_model="numpy")
 def filippov_reset(mode, guard, t, x, p, x_out):
     x_out[:] = x
     if mode == SLIDE:
@@ -133,7 +133,7 @@ def filippov_reset(mode, guard, t, x, p, x_out):
     return _surface_mode(x_out)
 
 
-@numba.njit(MODE_SIG, cache=True)
+@numba.njit(MODE_SIG, cache=True, error_model="numpy")
 def filippov_mode(t, x, p):
     if x[0] != 0.0:
         return ABOVE if x[0] > 0 else BELOW
@@ -150,25 +150,25 @@ def filippov_system():
 
 
 # ---------------------------------------------------------------- bouncing ball (Zeno)
-@numba.njit(VF_SIG, cache=True)
+@numba.njit(VF_SIG, cache=True, error_model="numpy")
 def ball_vf(mode, t, x, p, out):
     out[0] = x[1]
     out[1] = -p[0]
 
 
-@numba.njit(GUARD_SIG, cache=True)
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy")
 def ball_guards(mode, t, x, p, out):
     out[0] = x[0]
 
 
-@numba.njit(RESET_SIG, cache=True)
+@numba.njit(RESET_SIG, cache=True, error_model="numpy")
 def ball_reset(mode, guard, t, x, p, x_out):
     x_out[0] = 0.0
     x_out[1] = -p[1] * x[1]
     return 0
 
 
-@numba.njit(MODE_SIG, cache=True)
+@numba.njit(MODE_SIG, cache=True, error_model="numpy")
 def ball_mode(t, x, p):
     return 0
 
