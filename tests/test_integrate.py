@@ -177,3 +177,22 @@ def test_stop_mode_counts_entries():
     tr = hunting.simulate(loop.system, [0.1, 0.0, 0.0], (0.0, 100.0), stop_mode="stick", stop_count=3)
     assert tr.status == hunting.Status.STOPPED
     assert len(tr.events.entering(S.STICK)) == 3 and tr.mode_final == S.STICK
+
+
+@pytest.mark.parametrize("sigma0", [1e4, 1e6])
+def test_radau_handles_stiff_lugre_loops(sigma0):
+    """LuGre with sigma0 up to 1e6 N/m: Radau IIA agrees with DOP853 and needs far fewer steps
+    once the bristle dynamics are stiff."""
+    loop = hunting.preset("table4.1", sigma0=sigma0, sigma1=np.sqrt(sigma0), P=50.0, D=0.1, I=5.0,
+                          force_amplitude=0.0)
+    x0 = loop.state(x1=0.05)
+    te = np.linspace(0.0, 2.0, 21)
+    r = hunting.simulate(loop.system, x0, (0.0, 2.0), method="radau", rtol=1e-8, atol=1e-12, t_eval=te)
+    e = hunting.simulate(loop.system, x0, (0.0, 2.0), method="dop853", rtol=1e-10, atol=1e-14, t_eval=te)
+    assert r.success and e.success
+    # at step ends (t = 2) Radau has its full order; at t_eval points between steps its 3rd-order
+    # collocation polynomial interpolates
+    np.testing.assert_allclose(r.x[-1], e.x[-1], atol=1e-8)
+    np.testing.assert_allclose(r.x[:, :3], e.x[:, :3], atol=3e-5)
+    if sigma0 >= 1e6:
+        assert r.stats["n_steps"] * 5 < e.stats["n_steps"]
