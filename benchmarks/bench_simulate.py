@@ -56,7 +56,8 @@ def startup_times() -> tuple[float, float]:
 def main() -> None:
     loop = hunting.preset("table9.1")
     x0 = [0.1, 0.0, 0.0]
-    n_sticks = N_EVENTS // 3 + 1
+    n_sticks = len(hunting.simulate(loop.system, x0, (0.0, 1e3), rtol=RTOL, atol=ATOL,
+                                    max_events=N_EVENTS).events.entering(S.STICK))
 
     def run_hunting():
         return hunting.simulate(loop.system, x0, (0.0, 1e3), rtol=RTOL, atol=ATOL, max_events=N_EVENTS)

@@ -15,7 +15,7 @@ See docs/architecture.md ("Adding a system") for a complete example.
 import numba
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def filippov_weight(a_minus, a_plus):
     """lam in [0, 1] of the Filippov sliding field for a- = grad h . f-, a+ = grad h . f+.
 
@@ -26,20 +26,20 @@ def filippov_weight(a_minus, a_plus):
     return a_minus / den
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def filippov_combine(f_minus, f_plus, lam, out):
     """out = (1 - lam) f- + lam f+ (arrays of shape (n,))."""
     for i in range(out.size):
         out[i] = (1.0 - lam) * f_minus[i] + lam * f_plus[i]
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def filippov_attractive(a_minus, a_plus):
     """True when both fields point into the surface (sliding possible)."""
     return a_minus >= 0.0 and a_plus <= 0.0
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def direction_from_rest(F, Fs_pos, Fs_neg):
     """Direction of motion of a body at rest under non-friction force F with stick set
     [-Fs_neg, Fs_pos]: +1, -1, or 0 (it sticks)."""

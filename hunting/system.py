@@ -30,7 +30,10 @@ import numba
 import numpy as np
 from numba import types
 
+from ._fastcall import install as _install_fastcall
 from .errors import SystemDefinitionError
+
+_install_fastcall()
 
 _i8, _f8 = types.int64, types.float64
 _vec = types.float64[::1]

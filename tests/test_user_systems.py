@@ -82,3 +82,14 @@ def test_protocol_violations_are_named():
                                 param_names=(), params=np.zeros(2), vector_field=sys_.vector_field,
                                 guards=sys_.guards, transition=sys_.transition, mode_of=sys_.mode_of,
                                 directions=np.zeros((1, 3)))
+
+
+def test_memoized_function_addresses_match_numba():
+    from numba.experimental import function_type as ft
+
+    from hunting import _fastcall
+    from hunting.system import GUARD_SIG, VF_SIG
+    for sys_ in (ball_system(), two_mass_system(), hunting.preset("table9.1").system):
+        for fn, sig in ((sys_.vector_field, VF_SIG), (sys_.guards, GUARD_SIG)):
+            assert ft._get_wrapper_address(fn, sig) == _fastcall._orig_wrapper(fn, sig)
+            assert ft._get_jit_address(fn, sig) == _fastcall._orig_jit(fn, sig)

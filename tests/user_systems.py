@@ -19,7 +19,7 @@ def spring_force(t, x, p):
     return p[2] * (x[2] - x[0]) + p[3] * (x[3] - x[1])
 
 
-@numba.njit(VF_SIG, cache=True, error_model="numpy")
+@numba.njit(VF_SIG, cache=True, error_model="numpy", _nrt=False)
 def two_mass_vf(mode, t, x, p, out):
     F1 = spring_force(t, x, p)
     out[2] = x[3]
@@ -33,7 +33,7 @@ def two_mass_vf(mode, t, x, p, out):
         out[1] = (F1 - s * p[4]) / p[0]
 
 
-@numba.njit(GUARD_SIG, cache=True, error_model="numpy")
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy", _nrt=False)
 def two_mass_guards(mode, t, x, p, out):
     if mode == STICK:
         F1 = spring_force(t, x, p)

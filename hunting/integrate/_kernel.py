@@ -47,14 +47,14 @@ _S_FULL = int(Status.BUFFER_FULL)
 _S_INVALID = int(Status.INVALID_MODE)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, gs):
     dense_eval(method, t_old, h, y_old, Q, t, xs)
     guards(mode, t, xs, p, gs)
     return gs[i]
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, gs):
     """Root of g_i(t) + shift on [ta, tb] given opposite signs at the ends (Illinois method
     with bisection safeguard). Returns the right end of the final bracket: the first time at
@@ -92,7 +92,7 @@ def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, meth
     return tb
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def _armed_state(d, g, tol):
     """Is a guard with direction d and value g away from zero on its non-firing side?"""
     if d < 0:
@@ -102,7 +102,7 @@ def _armed_state(d, g, tol):
     return abs(g) > tol
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def _fires(d, ga, gb, shift_a_to_b):
     """Does the guard cross zero (after shift) from a to b in its firing direction?"""
     a = ga + shift_a_to_b
@@ -114,7 +114,7 @@ def _fires(d, ga, gb, shift_a_to_b):
     return False
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, gs):
     """Scan an unarmed guard over one step. Returns (event time or inf, armed at the end);
     an event found while still unarmed is a threshold event (armed False)."""
@@ -147,7 +147,7 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
     return np.inf, armed
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
              y_new, f_new, err):
     """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
@@ -159,7 +159,7 @@ def _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, 
     return True, 12 if method == METHOD_DOP853 else 6
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol, J, M, piv, Mr,
                   pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, gs):
     """Newton on the step length he = t_ev - t with the guard's slope from the dense output.

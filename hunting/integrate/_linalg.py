@@ -7,7 +7,7 @@ import numba
 import numpy as np
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def lu_factor(a, piv):
     """Factor ``a`` (m, m) in place into L\\U; ``piv`` (m,) int64 receives row swaps.
 
@@ -39,7 +39,7 @@ def lu_factor(a, piv):
     return True
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def lu_solve(lu, piv, b):
     """Solve in place ``A x = b`` with the factorization from :func:`lu_factor`."""
     m = lu.shape[0]

@@ -17,7 +17,7 @@ EPS = np.finfo(np.float64).eps
 NEWTON_MAXITER = 6
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def _rms_scaled(err, y, y_new, rtol, atol):
     n = err.size
     s = 0.0
@@ -28,7 +28,7 @@ def _rms_scaled(err, y, y_new, rtol, atol):
     return np.sqrt(s / n)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def select_initial_step(vf, mode, t, y, f, p, direction_span, order, rtol, atol, ytmp, ftmp):
     """Hairer's starting step (Solving ODEs I, II.4). Returns h > 0 (one extra f evaluation)."""
     n = y.size
@@ -60,7 +60,7 @@ def select_initial_step(vf, mode, t, y, f, p, direction_span, order, rtol, atol,
     return min(100 * h0, h1, direction_span)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f_new, err):
     """One explicit Runge-Kutta step (DP5 or DOP853, FSAL). Returns the scaled error norm.
 
@@ -76,7 +76,9 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
                 for j in range(s):
                     acc += DP5_A[s, j] * K[j, i]
                 ytmp[i] = y[i] + h * acc
-            vf(mode, t + DP5_C[s] * h, ytmp, p, K[s])
+            vf(mode, t + DP5_C[s] * h, ytmp, p, err)
+            for i in range(n):
+                K[s, i] = err[i]
         for i in range(n):
             acc = 0.0
             for j in range(ns):
@@ -101,7 +103,9 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
             for j in range(s):
                 acc += D853_A[s, j] * K[j, i]
             ytmp[i] = y[i] + h * acc
-        vf(mode, t + D853_C[s] * h, ytmp, p, K[s])
+        vf(mode, t + D853_C[s] * h, ytmp, p, err)
+        for i in range(n):
+            K[s, i] = err[i]
     for i in range(n):
         acc = 0.0
         for j in range(ns):
@@ -127,7 +131,7 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
     return abs(h) * e5 / np.sqrt(denom * n)
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def explicit_dense(method, vf, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
     """Fill the dense-output coefficients Q for the step just accepted (DOP853: 3 more f evals)."""
     n = y.size
@@ -159,7 +163,7 @@ def explicit_dense(method, vf, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
     return D853_NSE - D853_NS - 1
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", inline="always")
 def dense_eval(method, t_old, h, y_old, Q, t, out):
     """State at time t in [t_old, t_old + h] from the step's dense output."""
     n = y_old.size
@@ -184,7 +188,7 @@ def dense_eval(method, t_old, h, y_old, Q, t, out):
         out[i] = y_old[i] + acc
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def numerical_jacobian(vf, mode, t, y, f, p, rtol, atol, J, ytmp, ftmp):
     """Forward-difference Jacobian J (n, n) of the mode's vector field at (t, y)."""
     n = y.size
@@ -200,7 +204,7 @@ def numerical_jacobian(vf, mode, t, y, f, p, rtol, atol, J, ytmp, ftmp):
             J[i, j] = (ftmp[i] - f[i]) / dj
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def radau_step(vf, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, ytmp, y_new,
                f_new, err):
     """One Radau IIA (order 5) step with simplified Newton on the full 3n stage system.
@@ -300,7 +304,7 @@ def radau_step(vf, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, 
     return en, True, nfev
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def radau_dense(Z, Q):
     """Dense output of the collocation polynomial: Q[k] = (Z^T P)[:, k], k < 3."""
     n = Z.shape[1]

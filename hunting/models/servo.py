@@ -61,7 +61,7 @@ def _slip(v, s, p):
     return slip_force(v, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4])
 
 
-@numba.njit(VF_SIG, cache=True, error_model="numpy")
+@numba.njit(VF_SIG, cache=True, error_model="numpy", _nrt=False)
 def servo_vf(mode, t, x, p, out):
     model = p[MODEL]
     F = nonfriction_force(t, x, p)
@@ -97,7 +97,7 @@ def servo_vf(mode, t, x, p, out):
         out[3] = zdot
 
 
-@numba.njit(GUARD_SIG, cache=True, error_model="numpy")
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy", _nrt=False)
 def servo_guards(mode, t, x, p, out):
     model = p[MODEL]
     if model == MODEL_SWITCH:
@@ -126,7 +126,7 @@ def servo_guards(mode, t, x, p, out):
         out[1] = 1.0
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _switch_mode_at_rest(t, x, p):
     d = direction_from_rest(nonfriction_force(t, x, p), p[POS + 1], p[NEG + 1])
     if d > 0:
@@ -136,7 +136,7 @@ def _switch_mode_at_rest(t, x, p):
     return STICK
 
 
-@numba.njit(RESET_SIG, cache=True, error_model="numpy")
+@numba.njit(RESET_SIG, cache=True, error_model="numpy", _nrt=False)
 def servo_reset(mode, guard, t, x, p, x_out):
     for i in range(x.size):
         x_out[i] = x[i]
@@ -157,7 +157,7 @@ def servo_reset(mode, guard, t, x, p, x_out):
     return V_NEG if mode == V_POS else V_POS
 
 
-@numba.njit(MODE_SIG, cache=True, error_model="numpy")
+@numba.njit(MODE_SIG, cache=True, error_model="numpy", _nrt=False)
 def servo_mode_of(t, x, p):
     model = p[MODEL]
     if model == MODEL_SWITCH:
@@ -176,10 +176,10 @@ def servo_mode_of(t, x, p):
         return V_POS
     if x[1] < 0:
         return V_NEG
-    # at rest: the direction the velocity will take
-    out = np.empty(x.size)
-    servo_vf(V_POS, t, x, p, out)
-    return V_NEG if out[1] < 0 else V_POS
+    # at rest: the direction the velocity will take (sign of the acceleration)
+    zdot, Ff = lugre_rates(0.0, x[3], 1.0, p[POS], p[POS + 1], p[POS + 2], p[POS + 3], p[POS + 4],
+                           p[SIGMA0], p[SIGMA1], p[VD])
+    return V_NEG if nonfriction_force(t, x, p) - Ff < 0 else V_POS
 
 
 MODE_TABLES = {
