@@ -36,7 +36,12 @@ def _memo(cache, orig):
 
 
 def install() -> None:
-    """Install the memoized lookups (idempotent)."""
+    """Install the memoized lookups (idempotent) and silence numba's notice that first-class
+    function types are experimental (the kernels are built on them on purpose)."""
+    import warnings
+
+    from numba.core.errors import NumbaExperimentalFeatureWarning
+    warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
     if getattr(_ft._get_wrapper_address, "__wrapped__", None) is None:
         _ft._get_wrapper_address = _memo(_cache_wrapper, _orig_wrapper)
         _ft._get_jit_address = _memo(_cache_jit, _orig_jit)

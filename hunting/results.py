@@ -109,3 +109,24 @@ class Trajectory:
 def make_status(code: int, t: float | None = None) -> tuple[Status, str]:
     s = Status(int(code))
     return s, status_message(s, t)
+
+
+@dataclass(frozen=True)
+class SpecialPoint:
+    """A bifurcation or structural change found along a parameter sweep or branch.
+
+    kind : e.g. "fold", "equilibrium_stability", "period_doubling", "grazing"
+    index : index of the sweep point / branch point just before it
+    param : best estimate of the parameter value; interval : (lo, hi) bracketing it
+    precision : hi - lo; data : extra numbers (e.g. the stick error at the fold)"""
+
+    kind: str
+    index: int
+    param: float
+    interval: tuple
+    precision: float
+    data: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return dict(kind=self.kind, index=self.index, param=self.param, interval=list(self.interval),
+                    precision=self.precision, **{k: (float(v) if np.isscalar(v) else v) for k, v in self.data.items()})

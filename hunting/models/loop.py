@@ -87,6 +87,55 @@ class ServoLoop:
         """F_nf = cm u + f_ext - F_cog at state x [force unit]."""
         return float(S.nonfriction_force(float(t), self.system.check_state(x, "x"), self.system.params))
 
+    def require_stick_map(self) -> None:
+        """Raise unless the loop has an exact stick mode and is time invariant (event maps)."""
+        if self.stick_mode is None:
+            raise SystemDefinitionError(
+                f"{self.name}: event maps need the exact Switch model (model='switch'); "
+                f"this loop uses {type(self.friction).__name__}"
+                f"{'' if isinstance(self.friction, LuGre) else ' variant ' + repr(self.friction.variant)}")
+        if isinstance(self.plant.external_force, tuple):
+            raise SystemDefinitionError(
+                f"{self.name}: event maps need a time-invariant loop; external_force = "
+                f"{self.plant.external_force!r} depends on time")
+        if self.controller.ki * self.plant.motor_constant <= 0:
+            raise SystemDefinitionError(
+                f"{self.name}: event maps need integral action with cm ki > 0 (ki = {self.controller.ki!r})")
+
+    def _static_force(self, d) -> np.ndarray:
+        """Force on the mass at rest with error d, apart from the integral term: F_nf + cm ki x3."""
+        d = np.asarray(d, dtype=float)
+        pl = self.plant
+        fcog = 0.0 if pl.cogging is None else pl.cogging(d + pl.setpoint)
+        fconst = pl.external_force if isinstance(pl.external_force, (int, float)) else 0.0
+        return -pl.motor_constant * self.controller.kp * d + fconst - fcog
+
+    def breakaway_state(self, d) -> tuple[np.ndarray, np.ndarray]:
+        """States (m, n) at the end of a stick phase with error d (m,), and the slip mode that
+        follows. In stick x1 = d and x3 grows at rate d, so the non-friction force drifts at
+        rate -cm ki d until it leaves the stick set: at -Fs_neg for d > 0, at +Fs_pos for d < 0.
+        d = 0 is the equilibrium set: it never breaks away (mode = stick)."""
+        self.require_stick_map()
+        d = np.atleast_1d(np.asarray(d, dtype=float))
+        lo, hi = self.friction.stick_set
+        target = np.where(d > 0, lo, hi)
+        cm_ki = self.plant.motor_constant * self.controller.ki
+        x3 = (self._static_force(d) - target) / cm_ki
+        X = np.zeros((d.size, self.n_states))
+        X[:, 0] = d
+        X[:, 2] = np.where(d == 0, 0.0, x3)
+        mode = np.where(d > 0, S.SLIP_NEG, np.where(d < 0, S.SLIP_POS, S.STICK))
+        return X, mode
+
+    def stick_duration(self, X_entry) -> np.ndarray:
+        """Duration [s] of the stick phases entered at states X_entry (m, n): from entry until
+        break-away (inf for d = 0)."""
+        X_entry = np.atleast_2d(X_entry)
+        d = X_entry[:, 0]
+        Xb, _ = self.breakaway_state(d)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(d == 0, np.inf, (Xb[:, 2] - X_entry[:, 2]) / d)
+
     def equilibrium_set(self) -> tuple[float, float]:
         """Bounds of x3 on the equilibrium set x1 = x2 = 0 (Switch: cm ki |x3| within the stick
         set shifted by the cogging force at q_d) [x3 unit]."""

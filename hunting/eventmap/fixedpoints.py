@@ -1,0 +1,224 @@
+"""Fixed points of P^k: bracketed on a grid, refined on the true map, classified.
+
+A fixed point d* != 0 of P^k is a hunting limit cycle with k stick phases per period (after
+reduction to the minimal k); d* = 0 is the equilibrium set, whose stability follows from the
+one-sided slopes of P^k at the origin (maps can be discontinuous there, or unbounded in slope,
+for beta <= 1 and the discontinuous curve: thesis section 9.5).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import Status
+from ..models.loop import ServoLoop
+from .engine import EventMap, MapOptions, evaluate_map, event_map
+
+
+@dataclass(frozen=True)
+class OriginSlope:
+    """Behaviour of P^k near d = 0 from the right and the left.
+
+    slope_right, slope_left : P^k(delta)/delta at the smallest probe (NaN where a probe failed);
+    behaviour : "linear" (the ratios settle: P^k is linear near 0, as for beta > 1), "steep"
+    (the ratios still grow at the smallest probe: P^k(delta) shrinks more slowly than delta, a
+    slope that is unbounded or very large, beta = 1), "discontinuous" (|P^k(delta)| does not go
+    to 0: the map jumps at the origin, beta < 1 and the discontinuous curve) or "undefined" (a
+    probe failed; see its status);
+    probes : (deltas, ratios right, ratios left)."""
+
+    slope_right: float
+    slope_left: float
+    behaviour: str
+    probes: tuple
+
+    @property
+    def stable(self) -> bool:
+        if self.behaviour not in ("linear", "steep"):
+            return False
+        return max(abs(self.slope_right), abs(self.slope_left)) < 1.0
+
+
+@dataclass(frozen=True)
+class FixedPoint:
+    """A fixed point of P^k.
+
+    d : stick error [m]; iterate : minimal k; slope : d P^k / dd at d (for the equilibrium: the
+    larger one-sided slope in magnitude); stable : |slope| < 1 (equilibrium: not discontinuous
+    and contracting on both sides); kind : "equilibrium" or "cycle"; orbit : the k stick errors
+    of the cycle, starting at d; residual : |P^k(d) - d|; origin : OriginSlope of the
+    equilibrium; fit_d, fit_slope : the thesis' local fit (cubic through four grid neighbours,
+    or a line through the origin), when requested."""
+
+    d: float
+    iterate: int
+    slope: float
+    stable: bool
+    kind: str
+    orbit: tuple
+    residual: float
+    origin: OriginSlope | None = None
+    fit_d: float | None = None
+    fit_slope: float | None = None
+
+    def as_dict(self) -> dict:
+        out = dict(d=self.d, iterate=self.iterate, slope=self.slope, stable=bool(self.stable), kind=self.kind,
+                   orbit=[float(v) for v in self.orbit], residual=self.residual)
+        if self.origin is not None:
+            out["origin"] = dict(slope_right=self.origin.slope_right, slope_left=self.origin.slope_left,
+                                 behaviour=self.origin.behaviour)
+        if self.fit_d is not None:
+            out.update(fit_d=self.fit_d, fit_slope=self.fit_slope)
+        return out
+
+
+def _classify(deltas, images, ratios) -> str:
+    if not np.all(np.isfinite(ratios)):
+        return "undefined"
+    shrink = np.abs(images[-1]) / max(np.abs(images[-3]), 1e-300)     # over two decades
+    if shrink > 0.5:
+        return "discontinuous"
+    a, b = abs(ratios[-2]), abs(ratios[-1])
+    if abs(b - a) <= 0.02 * max(a, b):
+        return "linear"
+    return "steep" if b > a else "linear"
+
+
+def origin_slope(loop: ServoLoop, iterate: int, scale: float, options: MapOptions | None = None) -> OriginSlope:
+    """One-sided slopes of P^k at 0 from probes delta = scale * 10^-j, j = 2..7.
+
+    Smaller probes are not used: below about 1e-7 of the map's scale the break-away motion is
+    driven by a force difference that rounding errors of O(eps Fs) swamp."""
+    deltas = scale * 10.0 ** -np.arange(2, 8)
+    right = evaluate_map(loop, deltas, iterate, options)
+    left = evaluate_map(loop, -deltas, iterate, options)
+    rr = np.where(right.ok, right.image / deltas, np.nan)
+    rl = np.where(left.ok, left.image / -deltas, np.nan)
+    kinds = {_classify(deltas, right.image, rr), _classify(deltas, left.image, rl)}
+    for k in ("undefined", "discontinuous", "steep", "linear"):
+        if k in kinds:
+            behaviour = k
+            break
+    return OriginSlope(float(rr[-1]), float(rl[-1]), behaviour, (deltas, rr, rl))
+
+
+def _refine(loop, a, b, ga, gb, iterate, opt, tol, max_iter=200):
+    """Vectorized Illinois on g(d) = P^k(d) - d over brackets [a, b] with g(a) g(b) < 0."""
+    a, b, ga, gb = (np.array(v, dtype=float) for v in (a, b, ga, gb))
+    side = np.zeros(a.size, dtype=int)
+    active = np.ones(a.size, dtype=bool)
+    for _ in range(max_iter):
+        active &= np.abs(b - a) > tol
+        if not active.any():
+            break
+        idx = np.flatnonzero(active)
+        c = (a[idx] * gb[idx] - b[idx] * ga[idx]) / (gb[idx] - ga[idx])
+        bad = ~((c > np.minimum(a[idx], b[idx])) & (c < np.maximum(a[idx], b[idx])))
+        c[bad] = 0.5 * (a[idx] + b[idx])[bad]
+        mv = evaluate_map(loop, c, iterate, opt)
+        gc = np.where(mv.ok, mv.image - c, np.nan)
+        for j, k in enumerate(idx):
+            if not np.isfinite(gc[j]):
+                active[k] = False
+                continue
+            if gc[j] == 0.0:
+                a[k] = b[k] = c[j]
+                ga[k] = gb[k] = 0.0
+                active[k] = False
+            elif np.sign(gc[j]) == np.sign(gb[k]):
+                b[k], gb[k] = c[j], gc[j]
+                if side[k] == 1:
+                    ga[k] *= 0.5
+                side[k] = 1
+            else:
+                a[k], ga[k] = c[j], gc[j]
+                if side[k] == -1:
+                    gb[k] *= 0.5
+                side[k] = -1
+    use_b = np.abs(gb) < np.abs(ga)
+    return np.where(use_b, b, a)
+
+
+def _thesis_fit(grid, image, i):
+    """Cubic through four neighbouring points around bracket [i, i+1]: root of P^k(d) - d."""
+    lo = max(0, min(i - 1, grid.size - 4))
+    xs, ys = grid[lo:lo + 4], image[lo:lo + 4]
+    c = np.polyfit(xs, ys - xs, 3)
+    roots = np.roots(c)
+    roots = roots[np.isreal(roots)].real
+    roots = roots[(roots >= grid[i]) & (roots <= grid[i + 1])]
+    if roots.size == 0:
+        return None, None
+    r = float(roots[0])
+    return r, float(np.polyval(np.polyder(np.polyfit(xs, ys, 3)), r))
+
+
+def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
+                 options: MapOptions | None = None, thesis_fits: bool = False,
+                 emap: EventMap | None = None) -> list[FixedPoint]:
+    """All fixed points of P^k found on ``grid``, refined to |Δd| <= tol on the true map.
+
+    Cycles are reported once per orbit (the largest stick error of the orbit as ``d``) with
+    their minimal number of stick phases; the equilibrium set d = 0 is always reported when the
+    grid spans or touches 0. ``thesis_fits`` adds the thesis' local fits for comparison."""
+    opt = options or MapOptions()
+    grid = np.asarray(grid, dtype=float).ravel()
+    em = emap if emap is not None else event_map(loop, grid, iterate, derivative=False, options=opt)
+    g = em.image - em.grid
+    ok = em.ok
+    i = np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(g[:-1]) * np.sign(g[1:]) < 0)
+                       & (em.grid[:-1] * em.grid[1:] > 0))
+    roots = _refine(loop, em.grid[i], em.grid[i + 1], g[i], g[i + 1], iterate, opt, tol) if i.size else np.empty(0)
+    exact = np.flatnonzero(ok & (g == 0) & (em.grid != 0))
+    roots = np.concatenate([roots, em.grid[exact]])
+    brackets = list(i) + [None] * exact.size
+    out: list[FixedPoint] = []
+    seen: list[np.ndarray] = []
+    scale = max(np.max(np.abs(grid)), opt.d_floor)
+    for r, bi in zip(roots, brackets):
+        res = evaluate_map(loop, [r], iterate, opt)
+        resid = abs(res.image[0] - r)
+        if not res.ok[0] or resid > 1e-6 * max(abs(r), opt.d_floor):
+            continue                                   # a jump of the map, not a fixed point
+        orbit = [r]
+        x = r
+        for _ in range(iterate - 1):
+            x = float(evaluate_map(loop, [x], 1, opt).image[0])
+            orbit.append(x)
+        k = iterate
+        for j in range(1, iterate):
+            if iterate % j == 0 and abs(orbit[j] - r) < 1e-7 * max(abs(r), opt.d_floor):
+                k = j
+                break
+        orbit = np.array(orbit[:k])
+        if any(o.size == orbit.size and np.min(np.abs(o - r)) < 1e-7 * scale for o in seen):
+            continue
+        seen.append(orbit)
+        rep = float(orbit[np.argmax(orbit)])
+        h = opt.fd_step * max(abs(rep), opt.d_floor)
+        pm = evaluate_map(loop, [rep + h, rep - h], k, opt)
+        slope = float((pm.image[0] - pm.image[1]) / (2 * h))
+        fit_d = fit_s = None
+        if thesis_fits and bi is not None and rep == r:
+            fit_d, fit_s = _thesis_fit(em.grid, em.image, bi)
+        out.append(FixedPoint(rep, k, slope, abs(slope) < 1.0, "cycle", tuple(np.roll(orbit, -int(np.argmax(orbit)))),
+                              float(resid), None, fit_d, fit_s))
+    if grid.min() <= 0 <= grid.max():
+        os_ = origin_slope(loop, iterate, scale, opt)
+        slope = max(os_.slope_right, os_.slope_left, key=lambda v: abs(v) if np.isfinite(v) else np.inf)
+        fit_d = fit_s = None
+        if thesis_fits:
+            pos = np.flatnonzero((em.grid > 0) & ok)[:2]
+            if pos.size == 2:
+                x, y = em.grid[pos], em.image[pos]
+                fit_d, fit_s = 0.0, float(np.dot(x, y) / np.dot(x, x))
+        out.append(FixedPoint(0.0, 1, float(slope), os_.stable, "equilibrium", (0.0,), 0.0, os_, fit_d, fit_s))
+    out.sort(key=lambda f: (f.kind != "equilibrium", f.d))
+    return out
+
+
+def status_summary(em: EventMap) -> dict:
+    """Counts of each status on a map grid (by name)."""
+    names, counts = np.unique([Status(int(s)).name for s in em.status], return_counts=True)
+    return dict(zip(names.tolist(), counts.tolist()))
