@@ -2,8 +2,10 @@
 
     hunting models                      presets and their parameters with units
     hunting simulate PRESET [--set NAME=VALUE ...] [--x0 X1,X2,X3] [--t T] [--json F] [--plot F]
-    hunting demo [--out DIR]            the main job until the chapter reproducers land:
-                                        hunting cycles of chapters 8 and 9, printed and plotted
+    hunting eventmap PRESET [--set NAME=VALUE ...] --grid START:STOP:N [--iterate K]
+                     [--json FILE] [--plot FILE]
+    hunting reproduce ch9 [--out DIR]   a thesis chapter: tables and figures, checked
+    hunting demo [--out DIR]            short simulations of chapters 4, 8 and 9, checked
 """
 from __future__ import annotations
 
@@ -57,6 +59,51 @@ def _cmd_simulate(args) -> int:
     return 0 if tr.success else 1
 
 
+def _parse_grid(text: str) -> np.ndarray:
+    try:
+        a, b, n = text.split(":")
+        a, b, n = float(a), float(b), int(n)
+    except ValueError:
+        raise HuntingError(f"--grid {text!r} is not START:STOP:N (e.g. 0:0.5:501)") from None
+    if n < 2 or not (np.isfinite(a) and np.isfinite(b)) or b <= a:
+        raise HuntingError(f"--grid {text!r} is not allowed: need START < STOP and N >= 2")
+    return np.linspace(a, b, n)
+
+
+def _cmd_eventmap(args) -> int:
+    from .eventmap import event_map, fixed_points
+    from .models import preset
+    from .plotting import plot_event_map
+    loop = preset(args.preset, **_parse_sets(args.set))
+    grid = _parse_grid(args.grid)
+    em = event_map(loop, grid, args.iterate, derivative=False)
+    fps = fixed_points(loop, grid, args.iterate, emap=em)
+    for f in fps:
+        print(f"{f.kind:<12} d = {f.d:+.10f}  stick phases {f.iterate}  slope {f.slope:+.6g}  "
+              f"{'stable' if f.stable else 'unstable'}")
+    if args.json:
+        from .errors import Status
+        Path(args.json).write_text(json.dumps({
+            "preset": args.preset, "set": _parse_sets(args.set), "iterate": args.iterate,
+            "grid": em.grid.tolist(),
+            "image": [None if not ok else float(v) for v, ok in zip(em.image, em.ok)],
+            "status": [Status(int(s)).name for s in em.status],
+            "fixed_points": [dict(d=f.d, iterate=f.iterate, slope=f.slope, stable=bool(f.stable), kind=f.kind,
+                                  orbit=[float(o) for o in f.orbit]) for f in fps]}, indent=1))
+    if args.plot:
+        plot_event_map(em, fixed=fps, title=f"{loop.name}: P^{args.iterate}", path=args.plot)
+    return 0
+
+
+def _cmd_reproduce(args) -> int:
+    import importlib
+    chapters = {"ch9": "hunting.reproduce.ch9"}
+    if args.chapter not in chapters:
+        raise HuntingError(f"chapter {args.chapter!r} is not available: choose from {sorted(chapters)}")
+    mod = importlib.import_module(chapters[args.chapter])
+    return mod.run(Path(args.out or f"out/{args.chapter}"))
+
+
 def _cmd_demo(args) -> int:
     from .demo import run_demo
     return run_demo(Path(args.out))
@@ -74,11 +121,22 @@ def main(argv=None) -> int:
     sp.add_argument("--method", default="dop853")
     sp.add_argument("--json")
     sp.add_argument("--plot")
+    ep = sub.add_parser("eventmap", help="stick-to-stick event map and its fixed points")
+    ep.add_argument("preset")
+    ep.add_argument("--set", action="append", metavar="NAME=VALUE")
+    ep.add_argument("--grid", required=True, metavar="START:STOP:N")
+    ep.add_argument("--iterate", type=int, default=1)
+    ep.add_argument("--json")
+    ep.add_argument("--plot")
+    rp = sub.add_parser("reproduce", help="reproduce a thesis chapter (tables, figures, checks)")
+    rp.add_argument("chapter", help="ch9")
+    rp.add_argument("--out")
     dp = sub.add_parser("demo", help="hunting cycles of chapters 8 and 9, checked against the thesis")
     dp.add_argument("--out", default="out/demo")
     args = ap.parse_args(argv)
     try:
-        return {"models": _cmd_models, "simulate": _cmd_simulate, "demo": _cmd_demo}[args.cmd](args)
+        return {"models": _cmd_models, "simulate": _cmd_simulate, "eventmap": _cmd_eventmap,
+                "reproduce": _cmd_reproduce, "demo": _cmd_demo}[args.cmd](args)
     except HuntingError as e:
         print(f"hunting: error: {e}", file=sys.stderr)
         return 2

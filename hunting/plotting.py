@@ -72,3 +72,101 @@ def plot_hysteresis(force, displacement, *, title: str = "", path=None, units=("
     if path is not None:
         fig.savefig(path, dpi=120)
     return fig
+
+
+def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), title: str = "", ax=None,
+                   path=None, unit: str = "m"):
+    """P^k(d) against d with the diagonal; optional cobweb from ``cobweb_from`` (iterating the
+    true map) and fixed points (stable filled, unstable open)."""
+    plt = _plt()
+    own = ax is None
+    if own:
+        fig, ax = plt.subplots(figsize=(5.6, 5.0))
+    else:
+        fig = ax.figure
+    k = em.iterate
+    lab = "P(d)" if k == 1 else f"P$^{k}$(d)"
+    ax.plot(em.grid, em.image, ".", ms=2.0, color="C0", label=lab)
+    lo, hi = float(np.nanmin(em.grid)), float(np.nanmax(em.grid))
+    ax.plot([lo, hi], [lo, hi], "-", color="0.4", lw=0.8, label="diagonal")
+    ax.axhline(0, color="0.8", lw=0.6)
+    ax.axvline(0, color="0.8", lw=0.6)
+    if cobweb_from is not None:
+        from .eventmap.engine import evaluate_map
+        xs = [float(cobweb_from)]
+        for _ in range(cobweb_steps):
+            mv = evaluate_map(em.loop, [xs[-1]], k, em.options)
+            if not mv.ok[0]:
+                break
+            xs.append(float(mv.image[0]))
+        px, py = [xs[0]], [0.0]
+        for a, b in zip(xs[:-1], xs[1:]):
+            px += [a, b]
+            py += [b, b]
+        ax.plot(px, py, "-", color="C3", lw=0.9, label="cobweb")
+        ax.plot(xs[:-1], xs[1:], "o", color="C3", ms=4)
+    for f in fixed:
+        for d in ([f.d] if f.kind == "equilibrium" else [f.d, -f.d] if em.loop.odd and em.grid.min() < 0 else [f.d]):
+            ax.plot(d, d, "o", ms=7, mfc="k" if f.stable else "w", mec="k", zorder=5)
+    ax.set_xlabel(f"d$^n$ [{unit}]")
+    ax.set_ylabel(f"d$^{{n+{k}}}$ [{unit}]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    if title:
+        ax.set_title(title, fontsize=10)
+    if own:
+        fig.tight_layout()
+        if path is not None:
+            fig.savefig(path, dpi=130)
+    return fig
+
+
+def plot_map_diagram(diagram, *, title: str = "", ax=None, path=None, unit: str = "m"):
+    """Bifurcation diagram from event maps: cycle stick errors against the parameter, stable
+    solid and unstable dashed; the equilibrium set (d = 0) solid where stable, dashed where not;
+    folds and stability changes marked."""
+    plt = _plt()
+    own = ax is None
+    if own:
+        fig, ax = plt.subplots(figsize=(6.0, 4.2))
+    else:
+        fig = ax.figure
+    v = diagram.values
+    # cycles: connect points branch by branch (sorted by d within each parameter value)
+    branches: dict = {}
+    for i, fps in enumerate(diagram.fixed):
+        cyc = sorted([f for f in fps if f.kind == "cycle"], key=lambda f: f.d)
+        for j, f in enumerate(cyc):
+            key = (f.stable, j if f.stable else -1 - j)
+            branches.setdefault(key, []).append((v[i], f.d))
+    for sp in diagram.special:          # close the pair of branches at each fold
+        if sp.kind == "fold":
+            for key in ((True, 0), (False, -1)):
+                if key in branches:
+                    branches[key].append((sp.param, sp.data.get("d", 0.0)))
+    for (stable, _), pts in branches.items():
+        pts = np.array(sorted(pts))
+        ax.plot(pts[:, 0], pts[:, 1], "-" if stable else "--", color="k", lw=1.4 if stable else 1.1,
+                marker="o" if stable else None, ms=3)
+    eq = diagram.equilibrium_stable()
+    for i in range(v.size - 1):
+        ax.plot(v[i:i + 2], [0, 0], "-" if (eq[i] and eq[i + 1]) else "--", color="C0", lw=2.0 if eq[i] else 1.2)
+    for s in diagram.special:
+        if s.kind == "fold":
+            ax.plot(s.param, s.data.get("d", 0.0), "s", color="C3", ms=7, label=f"fold {diagram.param} = {s.param:.4g}")
+        else:
+            ax.plot(s.param, 0.0, "D", color="C2", ms=7, label=f"equilibrium set stable from {s.param:.4g}")
+    ax.plot([], [], "-", color="k", label="stable cycle")
+    ax.plot([], [], "--", color="k", label="unstable cycle")
+    ax.plot([], [], "-", color="C0", lw=2.0, label="equilibrium set (dashed: unstable)")
+    ax.set_xlabel(diagram.param)
+    ax.set_ylabel(f"stick error d* [{unit}]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    if title:
+        ax.set_title(title, fontsize=10)
+    if own:
+        fig.tight_layout()
+        if path is not None:
+            fig.savefig(path, dpi=130)
+    return fig
