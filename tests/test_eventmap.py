@@ -37,6 +37,8 @@ def test_map_is_odd_and_its_first_iterate_matches_simulation():
     a = evaluate_map(loop, d)
     b = evaluate_map(loop, -d)
     np.testing.assert_allclose(a.image, -b.image, atol=1e-12)
+    both = evaluate_map(loop, np.concatenate([d, -d]))      # odd loop: each |d| integrated once
+    np.testing.assert_allclose(both.image[d.size:], b.image, atol=1e-12)
     tr = hunting.simulate(loop.system, [0.1, 0.0, 0.0], (0.0, 3.0), rtol=1e-12, atol=1e-15)
     assert stick_map(loop, 0.1)[0] == pytest.approx(tr.events.x_after[1, 0], abs=1e-11)
     assert stick_map(loop, 0.1, 2)[0] == pytest.approx(tr.events.x_after[3, 0], abs=1e-11)

@@ -70,13 +70,28 @@ class MapValues:
 
 
 def evaluate_map(loop: ServoLoop, d, iterate: int = 1, options: MapOptions | None = None) -> MapValues:
-    """P^k(d) for an array of stick errors d (true map, parallel over points)."""
+    """P^k(d) for an array of stick errors d (true map, parallel over points).
+
+    For an odd loop (symmetric friction, no cogging, no external force: ``loop.odd``) each |d|
+    is integrated once and P^k(-d) = -P^k(d) is used; otherwise every point is integrated."""
     opt = options or MapOptions()
     if int(iterate) != iterate or iterate < 1:
         raise SystemDefinitionError(f"iterate = {iterate!r} is not allowed: it must be an integer >= 1")
     d = np.atleast_1d(np.asarray(d, dtype=float)).ravel()
     if not np.all(np.isfinite(d)):
         raise SystemDefinitionError("d must be finite")
+    if loop.odd and np.any(d < 0):
+        mags, inv = np.unique(np.abs(d), return_inverse=True)
+        if mags.size < d.size:
+            half = _evaluate(loop, mags, iterate, opt)
+            sgn = np.where(d < 0, -1.0, 1.0)
+            entry = half.entry[inv] * sgn[:, None]
+            return MapValues(d, half.image[inv] * sgn, half.status[inv], half.slip_time[inv],
+                             half.stick_time[inv], half.n_events[inv], entry)
+    return _evaluate(loop, d, iterate, opt)
+
+
+def _evaluate(loop: ServoLoop, d: np.ndarray, iterate: int, opt: MapOptions) -> MapValues:
     X0, mode0 = loop.breakaway_state(d)
     system = loop.system
     image = np.zeros_like(d)
