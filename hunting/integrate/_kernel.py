@@ -18,6 +18,7 @@ from numba import types
 
 from ..errors import Status
 from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE
+from ._rhs import jacobian_central_or_exact, rhs
 from ._steppers import (EPS, dense_eval, explicit_dense, explicit_step, numerical_jacobian,
                         radau_dense, radau_step, select_initial_step)
 from ._tableau import METHOD_DOP853, METHOD_DP5, METHOD_RADAU
@@ -47,15 +48,23 @@ _S_FULL = int(Status.BUFFER_FULL)
 _S_INVALID = int(Status.INVALID_MODE)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, gs):
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def _guards_base(guards, mode, t, y, p, out, xb):
+    """Guards of the base state y[:nb] (y may carry sensitivities after it)."""
+    for i in range(xb.size):
+        xb[i] = y[i]
+    guards(mode, t, xb, p, out)
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, xb, gs):
     dense_eval(method, t_old, h, y_old, Q, t, xs)
-    guards(mode, t, xs, p, gs)
+    _guards_base(guards, mode, t, xs, p, gs, xb)
     return gs[i]
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, gs):
+def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, xb, gs):
     """Root of g_i(t) + shift on [ta, tb] given opposite signs at the ends (Illinois method
     with bisection safeguard). Returns the right end of the final bracket: the first time at
     which the guard is on its firing side, to within a few ulps of t."""
@@ -74,7 +83,7 @@ def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, meth
             tc = 0.5 * (ta + tb)
         if not (ta < tc < tb):
             tc = 0.5 * (ta + tb)
-        fc = _guard_at(guards, mode, tc, t_old, h, y_old, Q, method, p, i, xs, gs) + shift
+        fc = _guard_at(guards, mode, tc, t_old, h, y_old, Q, method, p, i, xs, xb, gs) + shift
         if fc == 0.0:
             return tc
         if (fc > 0.0) == (fb > 0.0):
@@ -92,7 +101,7 @@ def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, meth
     return tb
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _armed_state(d, g, tol):
     """Is a guard with direction d and value g away from zero on its non-firing side?"""
     if d < 0:
@@ -102,7 +111,7 @@ def _armed_state(d, g, tol):
     return abs(g) > tol
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _fires(d, ga, gb, shift_a_to_b):
     """Does the guard cross zero (after shift) from a to b in its firing direction?"""
     a = ga + shift_a_to_b
@@ -115,7 +124,7 @@ def _fires(d, ga, gb, shift_a_to_b):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, gs):
+def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, xb, gs):
     """Scan an unarmed guard over one step. Returns (event time or inf, armed at the end);
     an event found while still unarmed is a threshold event (armed False)."""
     ta = t
@@ -127,19 +136,19 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
             gb = g1
         else:
             tb = t + h * k / (N_SAMPLES + 1)
-            gb = _guard_at(guards, mode, tb, t, h, y_old, Q, method, p, i, xs, gs)
+            gb = _guard_at(guards, mode, tb, t, h, y_old, Q, method, p, i, xs, xb, gs)
         if armed:
             if _fires(d, ga, gb, 0.0):
                 return locate_root(guards, mode, i, 0.0, ta, ga, tb, gb, t, h, y_old, Q, method, p,
-                                   xs, gs), True
+                                   xs, xb, gs), True
         else:
             # beyond the tolerance band on the firing side: fire at the band's edge
             if d <= 0 and gb < -tol and ga + tol >= 0.0:
                 return locate_root(guards, mode, i, tol, ta, ga, tb, gb, t, h, y_old, Q, method, p,
-                                   xs, gs), False
+                                   xs, xb, gs), False
             if d >= 0 and gb > tol and ga - tol <= 0.0:
                 return locate_root(guards, mode, i, -tol, ta, ga, tb, gb, t, h, y_old, Q, method, p,
-                                   xs, gs), False
+                                   xs, xb, gs), False
             if _armed_state(d, gb, tol):
                 armed = True
         ta = tb
@@ -148,20 +157,21 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
-             y_new, f_new, err):
+def _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr,
+             Z, F3, R, K, ytmp, y_new, f_new, err):
     """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
     if method == METHOD_RADAU:
-        en, conv, fe = radau_step(vf, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
-                                  R, ytmp, y_new, f_new, err)
+        en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, he, p, rtol, atol, J, M, piv,
+                                  Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
         return conv, fe
-    explicit_step(method, vf, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new, f_new, err)
+    explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new,
+                  f_new, err)
     return True, 12 if method == METHOD_DOP853 else 6
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol, J, M, piv, Mr,
-                  pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, gs):
+def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol,
+                  J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, xb, gs):
     """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
     On success xs holds the state at the returned event time; otherwise xs is left as the
     dense-output state and t_ev is returned unchanged. Returns (t_ev, f evaluations)."""
@@ -169,20 +179,20 @@ def _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, ato
     delta = 1e-7 * h
     ta = max(t, t_ev - delta)
     tb = min(t + h, t_ev + delta)
-    ga = _guard_at(guards, mode, ta, t, h, x, Q, method, p, i_ev, ytmp, gs)
-    gb = _guard_at(guards, mode, tb, t, h, x, Q, method, p, i_ev, ytmp, gs)
+    ga = _guard_at(guards, mode, ta, t, h, x, Q, method, p, i_ev, ytmp, xb, gs)
+    gb = _guard_at(guards, mode, tb, t, h, x, Q, method, p, i_ev, ytmp, xb, gs)
     if tb <= ta or ga == gb:
         return t_ev, 0
     slope = (gb - ga) / (tb - ta)
     he = t_ev - t
     nfev = 0
     for it in range(4):
-        ok, fe = _step_to(vf, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
-                          R, K, ytmp, y_new, f_new, err)
+        ok, fe = _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv,
+                          Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err)
         nfev += fe
         if not ok:
             return t_ev, nfev
-        guards(mode, t + he, y_new, p, gs)
+        _guards_base(guards, mode, t + he, y_new, p, gs, xb)
         dh = -gs[i_ev] / slope
         if abs(dh) <= 4.0 * EPS * max(abs(t + he), 1e-300) or it == 3:
             break
@@ -195,8 +205,56 @@ def _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, ato
     return t + he, nfev
 
 
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def saltation(vf, guards, reset, mode_old, mode_new, i_ev, t, xm, xp, p, S, fm, fp, grad, xw, xw2, gs, Rx):
+    """Saltation matrix S (nb, nb) of an event: x+ = R(x-) when guard i_ev of mode_old vanishes,
+
+        S = R_x + (f+ - R_x f-) n^T / (n . f- + h_t),
+
+    with f- the old mode's field at x-, f+ the new mode's at x+, n = grad h and R_x by central
+    differences (guards and resets are cheap; for the usual linear guards and resets the
+    differences are exact). Returns n . f- + h_t (near 0: grazing)."""
+    nb = xm.size
+    vf(mode_old, t, xm, p, fm)
+    vf(mode_new, t, xp, p, fp)
+    for i in range(nb):
+        xw[i] = xm[i]
+    for j in range(nb):
+        dj = np.cbrt(EPS) * max(abs(xm[j]), 1e-3)
+        xw[j] = xm[j] + dj
+        guards(mode_old, t, xw, p, gs)
+        gp = gs[i_ev]
+        reset(mode_old, i_ev, t, xw, p, xw2)
+        for i in range(nb):
+            Rx[i, j] = xw2[i]
+        xw[j] = xm[j] - dj
+        guards(mode_old, t, xw, p, gs)
+        gm = gs[i_ev]
+        reset(mode_old, i_ev, t, xw, p, xw2)
+        for i in range(nb):
+            Rx[i, j] = (Rx[i, j] - xw2[i]) / (2.0 * dj)
+        grad[j] = (gp - gm) / (2.0 * dj)
+        xw[j] = xm[j]
+    dt = np.cbrt(EPS) * max(abs(t), 1.0)
+    guards(mode_old, t + dt, xm, p, gs)
+    gp = gs[i_ev]
+    guards(mode_old, t - dt, xm, p, gs)
+    h_t = (gp - gs[i_ev]) / (2.0 * dt)
+    den = h_t
+    for j in range(nb):
+        den += grad[j] * fm[j]
+    for i in range(nb):
+        acc = 0.0
+        for k in range(nb):
+            acc += Rx[i, k] * fm[k]
+        jump = (fp[i] - acc) / den
+        for j in range(nb):
+            S[i, j] = Rx[i, j] + jump * grad[j]
+    return den
+
+
 KERNEL_SIG = types.void(
-    VF_TYPE, GUARD_TYPE, RESET_TYPE, JAC_TYPE, MODE_TYPE, types.boolean, types.int64,
+    VF_TYPE, GUARD_TYPE, RESET_TYPE, JAC_TYPE, MODE_TYPE, types.boolean, types.int64, types.int64,
     types.float64, types.float64, types.float64[::1], types.int64, types.float64[::1],
     types.int64[:, ::1],
     types.float64, types.float64, types.float64, types.float64, types.int64, types.int64,
@@ -210,7 +268,7 @@ KERNEL_SIG = types.void(
 
 
 @numba.njit(KERNEL_SIG, cache=True, error_model="numpy")
-def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
+def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                      t0, t1, x0, mode0, p, directions,
                      rtol, atol, h0, hmax, max_steps, max_events, guard_tol, fixed,
                      t_eval, record_steps, stop_mode, stop_count, zeno_count, zeno_window,
@@ -227,8 +285,13 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     into that mode (counted from ``info[I_STOPHITS]``). ``info[I_IEVAL]`` is the next t_eval
     index, ``info[I_NEVTOT]`` the events so far (both carried across resumes).
 
+    ``nb < x0.size`` integrates sensitivities: x0 = [x (nb), Phi0 row-major (nb * nb)], the
+    variational equations ride along (part of the error control) and every event multiplies Phi
+    by its saltation matrix. Guards, transitions and mode_of always see the base state only.
+
     Outputs: info (status, counts, final mode), finfo (final t, last step), x_final, and the
-    buffers out_* (points) and ev_* (event time, state before/after, guard, modes)."""
+    buffers out_* (points, all n columns) and ev_* (event time, base state before/after, guard,
+    modes)."""
     n = x0.size
     n_modes = directions.shape[0]
     ng = directions.shape[1]
@@ -240,8 +303,12 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     x = x0.copy()
     t = t0
     mode = mode0
+    xb = np.empty(nb)
+    xb2 = np.empty(nb)
+    for i in range(nb):
+        xb[i] = x[i]
     if mode < 0:
-        mode = mode_of(t, x, p)
+        mode = mode_of(t, xb, p)
     if mode < 0 or mode >= n_modes:
         info[I_STATUS] = _S_INVALID
         info[I_MODE] = mode
@@ -274,6 +341,16 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     # last error-controlled step size per mode: re-entering a mode starts from it instead of
     # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
     h_mode = np.full(n_modes, np.inf)
+    sens = nb < n
+    yw, fw, fp, fm, Jw = np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb), np.empty((nb, nb))
+    Jb = np.empty((nb, nb))
+    fbm = np.empty(nb)
+    fbp = np.empty(nb)
+    gradh = np.empty(nb)
+    Ssal = np.empty((nb, nb))
+    Rx = np.empty((nb, nb))
+    xw = np.empty(nb)
+    xw2 = np.empty(nb)
     n_threshold = 0   # consecutive events of guards that never left their tolerance band
 
     n_out = info[I_NOUT]
@@ -289,9 +366,8 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     expo = -1.0 / 8.0 if method == METHOD_DOP853 else (-1.0 / 5.0 if method == METHOD_DP5 else -0.25)
     status = _S_SUCCESS
 
-    vf(mode, t, x, p, f)
-    nfev += 1
-    guards(mode, t, x, p, g_old)
+    nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, p, f)
+    _guards_base(guards, mode, t, x, p, g_old, xb)
     for i in range(ng):
         armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
 
@@ -311,7 +387,8 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     if h0 > 0.0:
         h = h0
     else:
-        h = select_initial_step(vf, mode, t, x, f, p, max(t1 - t, 1e-300), order, rtol, atol, ytmp, ftmp)
+        h = select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, p, max(t1 - t, 1e-300), order,
+                                rtol, atol, ytmp, ftmp)
         nfev += 1
     n_small = 0
     rejected = False
@@ -340,14 +417,27 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
             status = _S_SMALL
             break
         if method == METHOD_RADAU:
-            if has_jac:
-                jac(mode, t, x, p, J)
+            if not sens:
+                if has_jac:
+                    jac(mode, t, x, p, J)
+                else:
+                    numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
+                    nfev += n
             else:
-                numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
-                nfev += n
+                # Newton matrix of the augmented system, dropping d(J Phi)/dx: J_x for the state
+                # and J_x kron I for row-major Phi (d Phi[i, j]/dt = sum_k J[i, k] Phi[k, j])
+                for i in range(nb):
+                    xw[i] = x[i]
+                nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, Jb, fbm, fbp, nb)
+                J[:, :] = 0.0
+                for i in range(nb):
+                    for k in range(nb):
+                        J[i, k] = Jb[i, k]
+                        for j in range(nb):
+                            J[nb + i * nb + j, nb + k * nb + j] = Jb[i, k]
             njac += 1
-            en, conv, fe = radau_step(vf, mode, t, x, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z,
-                                      F3, R, ytmp, y_new, f_new, err)
+            en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
+                                      Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
             nfev += fe
             if not conv:
                 n_rej += 1
@@ -357,7 +447,8 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
                     break
                 continue
         else:
-            en = explicit_step(method, vf, mode, t, x, f, h, p, rtol, atol, K, ytmp, y_new, f_new, err)
+            en = explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
+                               y_new, f_new, err)
             nfev += 12 if method == METHOD_DOP853 else 6
         finite = np.isfinite(en)
         for i in range(n):
@@ -385,7 +476,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
         n_steps += 1
         t_new = t1 if last else t + h
         # ---- events on this step; dense output only when a guard or t_eval needs it
-        guards(mode, t_new, y_new, p, g_new)
+        _guards_base(guards, mode, t_new, y_new, p, g_new, xb)
         need_dense = use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new
         for i in range(ng):
             if (not armed[i]) or _fires(directions[mode, i], g_old[i], g_new[i], 0.0):
@@ -393,7 +484,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
         if method == METHOD_RADAU:
             radau_dense(Z, Q)
         elif need_dense:
-            nfev += explicit_dense(method, vf, mode, t, x, y_new, f_new, h, p, K, ytmp, Q)
+            nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, y_new, f_new, h, p, K, ytmp, Q)
         t_ev = np.inf
         i_ev = -1
         ev_exact = True   # False for threshold events of unarmed guards (no polishing)
@@ -402,14 +493,14 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
             if armed[i]:
                 if _fires(d, g_old[i], g_new[i], 0.0):
                     tr = locate_root(guards, mode, i, 0.0, t, g_old[i], t_new, g_new[i], t, h, x, Q,
-                                     method, p, xs, gs)
+                                     method, p, xs, xb, gs)
                     if tr < t_ev:
                         t_ev = tr
                         i_ev = i
                         ev_exact = True
             else:
                 tr, arm_end = _scan_unarmed(guards, mode, i, d, guard_tol, t, g_old[i], t_new,
-                                            g_new[i], h, x, Q, method, p, xs, gs)
+                                            g_new[i], h, x, Q, method, p, xs, xb, gs)
                 if tr < t_ev:
                     t_ev = tr
                     i_ev = i
@@ -428,14 +519,31 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
             if ev_exact and t_ev > t:
                 # polish: integrate to the event with one step of the method itself, so the
                 # event state has the method's order rather than its dense output's
-                t_ev, fe = _polish_event(vf, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol,
-                                         atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new,
-                                         err, Q, xs, gs)
+                t_ev, fe = _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, guards, method, mode, i_ev, t, x, f, h,
+                                         t_ev, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
+                                         y_new, f_new, err, Q, xs, xb, gs)
                 nfev += fe
-            new_mode = reset(mode, i_ev, t_ev, xs, p, ytmp)
+            for i in range(nb):
+                xb[i] = xs[i]
+            new_mode = reset(mode, i_ev, t_ev, xb, p, xb2)
+            for i in range(nb):
+                ytmp[i] = xb2[i]
+            if sens and 0 <= new_mode < n_modes:
+                saltation(vf, guards, reset, mode, new_mode, i_ev, t_ev, xb, xb2, p, Ssal, fbm, fbp,
+                          gradh, xw, xw2, gs, Rx)
+                nfev += 2
+                for i in range(nb):
+                    for j in range(nb):
+                        acc = 0.0
+                        for k in range(nb):
+                            acc += Ssal[i, k] * xs[nb + k * nb + j]
+                        ytmp[nb + i * nb + j] = acc
+            elif sens:
+                for i in range(nb, n):
+                    ytmp[i] = xs[i]
             ev_t[n_ev] = t_ev
-            ev_xb[n_ev, :] = xs
-            ev_xa[n_ev, :] = ytmp
+            ev_xb[n_ev, :] = xb
+            ev_xa[n_ev, :] = xb2
             ev_guard[n_ev] = i_ev
             ev_from[n_ev] = mode
             ev_to[n_ev] = new_mode
@@ -482,9 +590,8 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
             if n_ev_total >= max_events:
                 status = _S_MAXEVENTS
                 break
-            vf(mode, t, x, p, f)
-            nfev += 1
-            guards(mode, t, x, p, g_old)
+            nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, p, f)
+            _guards_base(guards, mode, t, x, p, g_old, xb)
             for i in range(ng):
                 armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
             if fixed:

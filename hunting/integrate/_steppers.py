@@ -9,6 +9,7 @@ import numba
 import numpy as np
 
 from ._linalg import lu_factor, lu_solve
+from ._rhs import rhs
 from ._tableau import (D853_A, D853_B, D853_C, D853_D, D853_E3, D853_E5, D853_NS, D853_NSE,
                        DP5_A, DP5_B, DP5_C, DP5_E, DP5_P, METHOD_DOP853, METHOD_DP5,
                        RADAU_A, RADAU_C, RADAU_E, RADAU_MU_REAL, RADAU_P)
@@ -17,7 +18,7 @@ EPS = np.finfo(np.float64).eps
 NEWTON_MAXITER = 6
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _rms_scaled(err, y, y_new, rtol, atol):
     n = err.size
     s = 0.0
@@ -29,7 +30,8 @@ def _rms_scaled(err, y, y_new, rtol, atol):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def select_initial_step(vf, mode, t, y, f, p, direction_span, order, rtol, atol, ytmp, ftmp):
+def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, p, direction_span, order, rtol, atol,
+                        ytmp, ftmp):
     """Hairer's starting step (Solving ODEs I, II.4). Returns h > 0 (one extra f evaluation)."""
     n = y.size
     d0 = 0.0
@@ -47,7 +49,7 @@ def select_initial_step(vf, mode, t, y, f, p, direction_span, order, rtol, atol,
     h0 = min(h0, direction_span)
     for i in range(n):
         ytmp[i] = y[i] + h0 * f[i]
-    vf(mode, t + h0, ytmp, p, ftmp)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h0, ytmp, p, ftmp)
     d2 = 0.0
     for i in range(n):
         sc = atol + abs(y[i]) * rtol
@@ -60,8 +62,9 @@ def select_initial_step(vf, mode, t, y, f, p, direction_span, order, rtol, atol,
     return min(100 * h0, h1, direction_span)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
-def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f_new, err):
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
+                  f_new, err):
     """One explicit Runge-Kutta step (DP5 or DOP853, FSAL). Returns the scaled error norm.
 
     K: (16, n) stage derivatives (rows 0..6 used by DP5, 0..12 by DOP853); writes y_new, f_new."""
@@ -76,7 +79,7 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
                 for j in range(s):
                     acc += DP5_A[s, j] * K[j, i]
                 ytmp[i] = y[i] + h * acc
-            vf(mode, t + DP5_C[s] * h, ytmp, p, err)
+            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + DP5_C[s] * h, ytmp, p, err)
             for i in range(n):
                 K[s, i] = err[i]
         for i in range(n):
@@ -84,7 +87,7 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
             for j in range(ns):
                 acc += DP5_B[j] * K[j, i]
             y_new[i] = y[i] + h * acc
-        vf(mode, t + h, y_new, p, f_new)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h, y_new, p, f_new)
         for i in range(n):
             K[ns, i] = f_new[i]
         for i in range(n):
@@ -103,7 +106,7 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
             for j in range(s):
                 acc += D853_A[s, j] * K[j, i]
             ytmp[i] = y[i] + h * acc
-        vf(mode, t + D853_C[s] * h, ytmp, p, err)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + D853_C[s] * h, ytmp, p, err)
         for i in range(n):
             K[s, i] = err[i]
     for i in range(n):
@@ -111,7 +114,7 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
         for j in range(ns):
             acc += D853_B[j] * K[j, i]
         y_new[i] = y[i] + h * acc
-    vf(mode, t + h, y_new, p, f_new)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h, y_new, p, f_new)
     for i in range(n):
         K[ns, i] = f_new[i]
     e5 = 0.0
@@ -132,7 +135,7 @@ def explicit_step(method, vf, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new, f
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def explicit_dense(method, vf, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
+def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
     """Fill the dense-output coefficients Q for the step just accepted (DOP853: 3 more f evals)."""
     n = y.size
     if method == METHOD_DP5:
@@ -149,7 +152,7 @@ def explicit_dense(method, vf, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
             for j in range(s):
                 acc += D853_A[s, j] * K[j, i]
             ytmp[i] = y[i] + h * acc
-        vf(mode, t + D853_C[s] * h, ytmp, p, K[s])
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + D853_C[s] * h, ytmp, p, K[s])
     for i in range(n):
         dy = y_new[i] - y[i]
         Q[0, i] = dy
@@ -163,7 +166,7 @@ def explicit_dense(method, vf, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
     return D853_NSE - D853_NS - 1
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def dense_eval(method, t_old, h, y_old, Q, t, out):
     """State at time t in [t_old, t_old + h] from the step's dense output."""
     n = y_old.size
@@ -205,11 +208,12 @@ def numerical_jacobian(vf, mode, t, y, f, p, rtol, atol, J, ytmp, ftmp):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def radau_step(vf, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, ytmp, y_new,
-               f_new, err):
+def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
+               R, ytmp, y_new, f_new, err):
     """One Radau IIA (order 5) step with simplified Newton on the full 3n stage system.
 
-    ``J`` (n, n) must hold the Jacobian at (t, y). Returns (error norm, converged, f evals);
+    ``J`` (n, n) must hold the Jacobian of the integrated right-hand side at (t, y) (for an
+    augmented state, J_x for the state and J_x kron I for the row-major sensitivities). Returns (error norm, converged, f evals);
     when Newton does not converge the caller shrinks h. Writes Z (3, n) stage increments,
     y_new, f_new."""
     n = y.size
@@ -237,7 +241,7 @@ def radau_step(vf, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, 
         for a in range(3):
             for i in range(n):
                 ytmp[i] = y[i] + Z[a, i]
-            vf(mode, t + RADAU_C[a] * h, ytmp, p, F3[a])
+            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + RADAU_C[a] * h, ytmp, p, F3[a])
         nfev += 3
         finite = True
         for a in range(3):
@@ -290,7 +294,7 @@ def radau_step(vf, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, 
         # Hairer's refinement of the estimate for stiff components (one more f evaluation)
         for i in range(n):
             ytmp[i] = y[i] + err[i]
-        vf(mode, t, ytmp, p, f_new)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, ytmp, p, f_new)
         nfev += 1
         for i in range(n):
             acc = 0.0
@@ -299,7 +303,7 @@ def radau_step(vf, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, 
             err[i] = f_new[i] + acc / h
         lu_solve(Mr, pivr, err)
         en = _rms_scaled(err, y, y_new, rtol, atol)
-    vf(mode, t + h, y_new, p, f_new)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h, y_new, p, f_new)
     nfev += 1
     return en, True, nfev
 

@@ -50,6 +50,23 @@ def stribeck_level(vrel, Fc, Fs, vs, beta):
 
 
 @numba.njit(cache=True, error_model="numpy", inline='always')
+def stribeck_level_slope(vrel, Fc, Fs, vs, beta):
+    """d g / d vrel of :func:`stribeck_level` (consistent with its extension past 0)."""
+    if beta == BETA_DISCONTINUOUS or Fs == Fc:
+        return 0.0
+    r = vrel / vs
+    if beta == 2.0:
+        dpow = 2.0 * r
+    elif beta == 1.0:
+        dpow = 1.0
+    elif r > 0.0 or beta == math.floor(beta):
+        dpow = beta * r ** (beta - 1.0)
+    else:
+        dpow = 0.0
+    return -(Fs - Fc) * math.exp(-pow_ext(r, beta)) * dpow / vs
+
+
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def slip_force(v, s, Fc, Fs, vs, beta, b):
     """Friction force in slip with direction s = +1 / -1 (taken from the mode): s g(s v) + b v."""
     return s * stribeck_level(s * v, Fc, Fs, vs, beta) + b * v
@@ -214,6 +231,24 @@ def lugre_rates(v, z, s, Fc, Fs, vs, beta, b, sigma0, sigma1, vd):
     if vd > 0.0:
         s1 = sigma1 * math.exp(-(v / vd) ** 2)
     return zdot, sigma0 * z + s1 * zdot + b * v
+
+
+@numba.njit(cache=True, error_model="numpy", inline='always')
+def lugre_partials(v, z, s, Fc, Fs, vs, beta, b, sigma0, sigma1, vd):
+    """Partial derivatives of (dz/dt, F) of :func:`lugre_rates` with respect to v and z:
+    returns (dzdot/dv, dzdot/dz, dF/dv, dF/dz)."""
+    r = s * v
+    g = stribeck_level(r, Fc, Fs, vs, beta)
+    dg = stribeck_level_slope(r, Fc, Fs, vs, beta) * s
+    zdot = v - sigma0 * r * z / g
+    dzv = 1.0 - sigma0 * z * (s * g - r * dg) / (g * g)
+    dzz = -sigma0 * r / g
+    s1 = sigma1
+    ds1 = 0.0
+    if vd > 0.0:
+        s1 = sigma1 * math.exp(-(v / vd) ** 2)
+        ds1 = -2.0 * v / (vd * vd) * s1
+    return dzv, dzz, ds1 * zdot + s1 * dzv + b, sigma0 + s1 * dzz
 
 
 @dataclass(frozen=True)

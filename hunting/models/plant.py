@@ -51,6 +51,34 @@ def cogging_force(q, p, base):
 
 
 @numba.njit(cache=True, error_model="numpy", inline='always')
+def cogging_slope(q, p, base):
+    """dF_cog/dq [N/m] of :func:`cogging_force` (table: the slope of the segment; 0 outside)."""
+    kind = p[base]
+    if kind == COG_NONE:
+        return 0.0
+    n = int(p[base + 1])
+    d = base + 3
+    if kind == COG_HARMONIC:
+        w = 2.0 * math.pi / p[base + 2]
+        acc = 0.0
+        for k in range(n):
+            wk = w * (k + 1)
+            acc += -p[d + 2 * k] * wk * math.sin(wk * q) + p[d + 2 * k + 1] * wk * math.cos(wk * q)
+        return acc
+    if q <= p[d] or q >= p[d + n - 1]:
+        return 0.0
+    lo = 0
+    hi = n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if p[d + mid] <= q:
+            lo = mid
+        else:
+            hi = mid
+    return (p[d + n + hi] - p[d + n + lo]) / (p[d + hi] - p[d + lo])
+
+
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def external_force(t, kind, amplitude, period):
     """Known external force [N]: none, constant, or a triangle wave that starts at 0, rises to
     +amplitude at period/4, falls to -amplitude at 3 period/4 and returns to 0 at period."""

@@ -26,9 +26,9 @@ import numba
 import numpy as np
 
 from ..sliding import direction_from_rest
-from ..system import GUARD_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, PiecewiseSystem
-from .friction import lugre_rates, slip_force
-from .plant import cogging_force, external_force
+from ..system import GUARD_SIG, JAC_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, PiecewiseSystem
+from .friction import lugre_partials, lugre_rates, slip_force, stribeck_level_slope
+from .plant import cogging_force, cogging_slope, external_force
 
 # ---- flat parameter layout
 M, CM, KP, KD, KI, QD, FEXT_KIND, FEXT_AMP, FEXT_PERIOD, MODEL = range(10)
@@ -95,6 +95,56 @@ def servo_vf(mode, t, x, p, out):
         out[0] = x[1]
         out[1] = (F - Ff) / m
         out[3] = zdot
+
+
+@numba.njit(JAC_SIG, cache=True, error_model="numpy", _nrt=False)
+def servo_jac(mode, t, x, p, J):
+    """Analytic Jacobian of :func:`servo_vf` in ``mode`` (the mode's smooth field)."""
+    n = x.size
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = 0.0
+    J[2, 0] = 1.0
+    model = p[MODEL]
+    m = p[M]
+    cm = p[CM]
+    # gradient of the non-friction force
+    F1 = -cm * p[KP] - cogging_slope(x[0] + p[QD], p, COG)
+    F2 = -cm * p[KD]
+    F3 = -cm * p[KI]
+    if model == MODEL_SWITCH and mode == STICK:
+        return
+    if model == MODEL_BANDED and mode == BAND_STICK:
+        J[1, 1] = -p[ALPHA]
+        return
+    J[0, 1] = 1.0
+    if model == MODEL_BANDED and mode == BAND_TRANSITION:
+        J[1, 0] = F1 / m
+        J[1, 1] = F2 / m
+        J[1, 2] = F3 / m
+        return
+    if model == MODEL_LUGRE:
+        s = 1.0 if mode == V_POS else -1.0
+        base = POS if s > 0 else NEG
+        dzv, dzz, dFv, dFz = lugre_partials(x[1], x[3], s, p[base], p[base + 1], p[base + 2], p[base + 3],
+                                            p[base + 4], p[SIGMA0], p[SIGMA1], p[VD])
+        J[1, 0] = F1 / m
+        J[1, 1] = (F2 - dFv) / m
+        J[1, 2] = F3 / m
+        J[1, 3] = -dFz / m
+        J[3, 1] = dzv
+        J[3, 3] = dzz
+        return
+    # slip of the Switch models: friction s g(s v) + b v, d/dv = g'(s v) + b
+    if model == MODEL_BANDED:
+        s = 1.0 if x[1] > 0 else -1.0
+    else:
+        s = 1.0 if mode == SLIP_POS else -1.0
+    base = POS if s > 0 else NEG
+    dslip = stribeck_level_slope(s * x[1], p[base], p[base + 1], p[base + 2], p[base + 3]) + p[base + 4]
+    J[1, 0] = F1 / m
+    J[1, 1] = (F2 - dslip) / m
+    J[1, 2] = F3 / m
 
 
 @numba.njit(GUARD_SIG, cache=True, error_model="numpy", _nrt=False)
@@ -199,5 +249,5 @@ def build_servo_system(name: str, params: np.ndarray, *, odd: bool, units: dict)
     return PiecewiseSystem(
         name=name, state_names=states, modes=modes, guard_names=guard_names,
         param_names=PARAM_NAMES, params=params, vector_field=servo_vf, guards=servo_guards,
-        transition=servo_reset, mode_of=servo_mode_of, directions=np.array(directions),
+        transition=servo_reset, mode_of=servo_mode_of, directions=np.array(directions), jacobian=servo_jac,
         odd=odd, mirror_mode=np.array(mirror) if odd else None, units=units)

@@ -1,0 +1,89 @@
+"""The flow map x(T) = phi(T; x0) of a piecewise-smooth system and its Jacobian (monodromy when
+the orbit closes): variational equations integrated with the state, saltation matrices at
+every event (hunting.integrate._kernel)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import Status, SystemDefinitionError
+from ..integrate import _kernel as K
+from ..integrate._tableau import METHODS
+from ..system import PiecewiseSystem, no_jacobian
+
+
+@dataclass(frozen=True)
+class Flow:
+    """x : (n,) state at T; Phi : (n, n) d x(T) / d x0; mode : mode at T; f : (n,) vector field at
+    x(T) in that mode; events : (k,) event times; modes : (k + 1,) mode sequence; status."""
+
+    x: np.ndarray
+    Phi: np.ndarray
+    mode: int
+    f: np.ndarray
+    event_times: np.ndarray
+    modes: np.ndarray
+    guards: np.ndarray
+    status: Status
+
+    @property
+    def ok(self) -> bool:
+        return self.status in (Status.SUCCESS, Status.STOPPED)
+
+
+def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, params=None,
+         method: str = "dop853", rtol: float = 1e-11, atol: float = 1e-13, sensitivity: bool = True,
+         max_steps: int = 500_000, max_events: int = 10_000, guard_tol: float = 1e-12,
+         stop_mode: int = -1, stop_count: int = 1) -> Flow:
+    """Integrate over [0, T] (or until the stop condition) with the fundamental matrix Phi."""
+    x0 = system.check_state(x0)
+    if not (np.isfinite(T) and T > 0):
+        raise SystemDefinitionError(f"T = {T!r} is not allowed: the period must be a finite number > 0")
+    n = system.n_states
+    p = system.params if params is None else np.ascontiguousarray(params, dtype=np.float64)
+    y0 = np.concatenate([x0, np.eye(n).ravel()]) if sensitivity else x0.copy()
+    N = y0.size
+    out_t, out_x, out_m = np.empty(1), np.empty((1, N)), np.empty(1, dtype=np.int64)
+    cap = max_events + 1
+    ev_t, ev_xb, ev_xa = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
+    ev_g, ev_f, ev_to = (np.empty(cap, dtype=np.int64) for _ in range(3))
+    info = np.zeros(K.N_INFO, dtype=np.int64)
+    finfo = np.zeros(K.N_FINFO)
+    yf = np.empty(N)
+    jac = system.jacobian if system.jacobian is not None else no_jacobian
+    K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
+                       system.jacobian is not None, METHODS[method], n, 0.0, float(T), y0,
+                       -1 if mode0 is None else int(mode0), p, system.directions, rtol, atol, 0.0, np.inf,
+                       int(max_steps), int(max_events), guard_tol, False, np.empty(0), False, int(stop_mode),
+                       int(stop_count), 50, 1e-12 * T, out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f,
+                       ev_to, info, finfo, yf)
+    st = Status(int(info[K.I_STATUS]))
+    if st == Status.BUFFER_FULL:
+        st = Status.MAX_EVENTS
+    nev = int(info[K.I_NEV])
+    mode = int(info[K.I_MODE])
+    x = yf[:n].copy()
+    f = np.empty(n)
+    if 0 <= mode < system.n_modes:
+        system.vector_field(mode, float(finfo[K.F_T]), x, p, f)
+    else:
+        f[:] = np.nan
+    Phi = yf[n:].reshape(n, n).copy() if sensitivity else np.full((n, n), np.nan)
+    modes = np.concatenate([[ev_f[0]] if nev else [mode], ev_to[:nev]])
+    return Flow(x, Phi, mode, f, ev_t[:nev].copy(), modes, ev_g[:nev].copy(), st)
+
+
+def fd_jacobian(system, x0, T, *, mode0=None, rel: float = 1e-6, **kw) -> np.ndarray:
+    """Central finite differences of the flow map x0 -> x(T) (for checks)."""
+    x0 = np.asarray(x0, dtype=float)
+    n = x0.size
+    J = np.empty((n, n))
+    for j in range(n):
+        h = rel * max(abs(x0[j]), 1e-3)
+        xp, xm = x0.copy(), x0.copy()
+        xp[j] += h
+        xm[j] -= h
+        J[:, j] = (flow(system, xp, T, mode0=mode0, sensitivity=False, **kw).x
+                   - flow(system, xm, T, mode0=mode0, sensitivity=False, **kw).x) / (2 * h)
+    return J
