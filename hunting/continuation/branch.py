@@ -1,0 +1,296 @@
+"""Pseudo-arclength continuation of periodic orbits in one parameter.
+
+Unknowns u = (x0 without the section component, T, mu), scaled by their magnitudes at the
+start. Predictor: the unit tangent (null vector of [F_z | F_mu], oriented along the previous
+one). Corrector: Newton on [F(u); t . (u - u_pred)] = 0 with the monodromy-based F_z and
+F_mu by central differences in mu. Step size grows after easy corrections and shrinks after
+failed ones. At every point: Floquet multipliers and stability. Special points: folds (mu
+turns back; a multiplier passes +1) located by bisection in arclength, period doublings
+(a multiplier passes -1) and changes in the event sequence (a stick phase or velocity
+reversal appears or vanishes: grazing).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..errors import Status, SystemDefinitionError
+from ..results import SpecialPoint
+from ..system import PiecewiseSystem
+from .flow import flow
+from .shooting import PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude, shoot
+
+
+@dataclass(frozen=True)
+class ContinuationOptions:
+    """ds : first step (in scaled arclength); ds_min, ds_max : bounds; max_points : bound on
+    branch points; newton_tol, newton_max : corrector; dmu : relative step of the central
+    difference in the parameter; fold_tol : relative parameter width at which a fold stops
+    being refined; max_correction : largest corrector move as a fraction of ds and max_angle
+    [rad] the largest turn of the tangent in one step (larger ones halve ds: no branch jumping)."""
+
+    ds: float = 0.05
+    ds_min: float = 1e-6
+    ds_max: float = 0.3
+    max_points: int = 400
+    newton_tol: float = 1e-9
+    newton_max: int = 10
+    dmu: float = 1e-6
+    fold_tol: float = 1e-7
+    max_correction: float = 0.3
+    step_tol: float = 1e-10
+    max_angle: float = 0.15
+
+    def __post_init__(self):
+        for name in ("ds", "ds_min", "ds_max", "newton_tol", "dmu", "fold_tol"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise SystemDefinitionError(f"{name} = {v!r} is not allowed: it must be a finite number > 0")
+        if self.ds_min > self.ds or self.ds > self.ds_max:
+            raise SystemDefinitionError(f"need ds_min <= ds <= ds_max, got {self.ds_min}, {self.ds}, {self.ds_max}")
+
+
+@dataclass(frozen=True)
+class Branch:
+    """A branch of periodic orbits.
+
+    param : name; mu : (m,) parameter values; period : (m,); amplitude : (m,) max |x1|;
+    multipliers : (m, n) complex (trivial first); stable : (m,) bool; x0 : (m, n);
+    modes : list of mode sequences; special : list of SpecialPoint; status, message."""
+
+    param: str
+    mu: np.ndarray
+    period: np.ndarray
+    amplitude: np.ndarray
+    multipliers: np.ndarray
+    stable: np.ndarray
+    x0: np.ndarray
+    modes: list
+    special: list
+    status: Status
+    message: str
+    label: str = ""
+
+    def as_dict(self) -> dict:
+        pts = [dict(param=float(m), period=float(T), amplitude=float(a),
+                    multipliers=[[float(z.real), float(z.imag)] for z in lam], stable=bool(s))
+               for m, T, a, lam, s in zip(self.mu, self.period, self.amplitude, self.multipliers, self.stable)]
+        return dict(param=self.param, label=self.label, status=self.status.name, message=self.message,
+                    points=pts, special_points=[s.as_dict() for s in self.special])
+
+
+def _scaled(r, x):
+    """max |r_i| / scale_i with scale_i = max(|x_i|, 0.1 max|x|): components that are zero on the
+    section (x1 = 0) are measured against the orbit's size, not against zero."""
+    return float(np.max(np.abs(r) / np.maximum(np.abs(x), 0.1 * np.max(np.abs(x)) + 1e-300)))
+
+
+def _nontrivial_near(lam, target):
+    rest = lam[1:]
+    k = int(np.argmin(np.abs(rest - target)))
+    return rest[k]
+
+
+def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: PeriodicOrbit, mu0: float,
+                   mu_end: float, *, param: str = "mu", section: int = 0,
+                   options: ContinuationOptions | None = None, shooting: ShootingOptions | None = None,
+                   stop_at_mu: float | None = None, max_turns: int = 1) -> Branch:
+    """Follow the branch through ``orbit`` (at parameter mu0) towards mu_end.
+
+    system_at(mu) returns the system at parameter mu (its compiled functions are shared, only the
+    parameters change). The run stops when mu leaves [min(mu0, mu_end), max(mu0, mu_end)],
+    after ``max_turns`` folds once mu passes ``stop_at_mu`` (if given) on the way back, at
+    max_points, or when the step falls below ds_min."""
+    opt = options or ContinuationOptions()
+    sopt = shooting or ShootingOptions()
+    n = len(orbit.x0)
+    free = [i for i in range(n) if i != section]
+    c_sec = float(orbit.x0[section])
+    scale = np.concatenate([np.maximum(np.abs(orbit.x0[free]), 1e-3 * np.max(np.abs(orbit.x0))),
+                            [orbit.period, max(abs(mu0), 1e-6)]])
+    lo, hi = sorted((mu0, mu_end))
+    kw = dict(method=sopt.method, rtol=sopt.rtol, atol=sopt.atol, max_events=sopt.max_events,
+              max_steps=sopt.max_steps)
+
+    def unpack(v):
+        u = v * scale
+        x = np.empty(n)
+        x[section] = c_sec
+        x[free] = u[:-2]
+        return x, u[-2], u[-1]
+
+    def residual_and_jac(v, need_jac=True):
+        x, T, mu = unpack(v)
+        sys_ = system_at(mu)
+        fl = flow(sys_, x, T, sensitivity=need_jac, **kw)
+        if not fl.ok or T <= 0:
+            return None
+        r = fl.x - x
+        if not need_jac:
+            return r, None, fl
+        h = opt.dmu * max(abs(mu), 1e-3)
+        fp = flow(system_at(mu + h), x, T, sensitivity=False, **kw)
+        fm = flow(system_at(mu - h), x, T, sensitivity=False, **kw)
+        if not (fp.ok and fm.ok):
+            return None
+        Fmu = (fp.x - fm.x) / (2 * h)
+        Jz = np.column_stack([(fl.Phi - np.eye(n))[:, free], fl.f, Fmu]) * scale[None, :]
+        return r, Jz, fl
+
+    def tangent(J, prev=None):
+        _, _, vt = np.linalg.svd(J)
+        t = vt[-1]
+        if prev is not None and np.dot(t, prev) < 0:
+            t = -t
+        return t / np.linalg.norm(t)
+
+    def correct(v_pred, t):
+        v = v_pred.copy()
+        for k in range(opt.newton_max):
+            out = residual_and_jac(v)
+            if out is None:
+                return None
+            r, J, fl = out
+            res = _scaled(r, unpack(v)[0])
+            g = np.dot(t, v - v_pred)
+            if res < opt.newton_tol and abs(g) < 1e-12:
+                return v, J, fl, k
+            A = np.vstack([J, t])
+            try:
+                dv = np.linalg.solve(A, -np.append(r, g))
+            except np.linalg.LinAlgError:
+                return None
+            v = v + dv
+            # the residual of a strongly unstable orbit has a noise floor (integration error
+            # amplified by its multiplier): a negligible Newton step also means convergence
+            if np.linalg.norm(dv) < opt.step_tol and res < 1e3 * opt.newton_tol:
+                out = residual_and_jac(v)
+                if out is None:
+                    return None
+                return v, out[1], out[2], k + 1
+        out = residual_and_jac(v)
+        if out is None:
+            return None
+        r, J, fl = out
+        return (v, J, fl, opt.newton_max) if _scaled(r, unpack(v)[0]) < 10 * opt.newton_tol else None
+
+    v = np.concatenate([orbit.x0[free], [orbit.period, mu0]]) / scale
+    out = residual_and_jac(v)
+    if out is None:
+        raise SystemDefinitionError("the starting orbit could not be integrated")
+    r, J, fl = out
+    t = tangent(J)
+    if np.sign(t[-1]) != np.sign(mu_end - mu0):
+        t = -t
+    pts_v, pts_fl, tangents = [v], [fl], [t]
+    special: list[SpecialPoint] = []
+    ds = opt.ds
+    status, message = Status.SUCCESS, "reached the end of the parameter range"
+    turns = 0
+    while True:
+        if len(pts_v) >= opt.max_points:
+            status, message = Status.MAX_STEPS, f"max_points = {opt.max_points} reached"
+            break
+        v_pred = v + ds * t
+        res = correct(v_pred, t)
+        if res is None:
+            ds *= 0.5
+            if ds < opt.ds_min:
+                status, message = Status.NEWTON_FAILED, (f"corrector failed at step ds < ds_min = {opt.ds_min:g} "
+                                                         f"near {param} = {unpack(v)[2]:.6g}")
+                break
+            continue
+        v_new, J_new, fl_new, iters = res
+        t_new = tangent(J_new, t)
+        # guard against jumping to a nearby branch: the corrector must stay close to the
+        # predictor and the tangent must not turn too much in one step
+        if (np.linalg.norm(v_new - v_pred) > opt.max_correction * ds
+                or np.dot(t_new, t) < np.cos(opt.max_angle)) and ds > opt.ds_min * 4:
+            ds *= 0.5
+            continue
+        mu_new = unpack(v_new)[2]
+        # fold: the parameter component of the tangent changes sign
+        if np.sign(t_new[-1]) != np.sign(t[-1]):
+            sp = _refine_fold(correct, tangent, unpack, v, t, ds, opt, len(pts_v) - 1)
+            special.append(sp)
+            turns += 1
+        if tuple(fl_new.modes) != tuple(fl.modes) and len(fl_new.modes) != len(fl.modes):
+            special.append(SpecialPoint("event_sequence", len(pts_v) - 1, 0.5 * (unpack(v)[2] + mu_new),
+                                        tuple(sorted((unpack(v)[2], mu_new))), abs(mu_new - unpack(v)[2]),
+                                        {"events_before": len(fl.modes) - 1, "events_after": len(fl_new.modes) - 1}))
+        v, t, fl = v_new, t_new, fl_new
+        pts_v.append(v)
+        pts_fl.append(fl)
+        tangents.append(t)
+        if mu_new < lo or mu_new > hi:
+            break
+        if turns >= max_turns and stop_at_mu is not None:
+            if (t[-1] < 0 and mu_new <= stop_at_mu) or (t[-1] > 0 and mu_new >= stop_at_mu):
+                message = f"stopped at {param} = {mu_new:.6g} after {turns} fold(s)"
+                break
+        if iters <= 4:
+            ds = min(opt.ds_max, ds * 1.4)
+        elif iters >= 7:
+            ds = max(opt.ds_min, ds * 0.6)
+    # assemble
+    mus, Ts, amps, lams, stab, xs, modes = [], [], [], [], [], [], []
+    for vv, ff in zip(pts_v, pts_fl):
+        x, T, mu = unpack(vv)
+        lam, _ = floquet(ff.Phi, ff.f)
+        mus.append(mu)
+        Ts.append(T)
+        xs.append(x)
+        lams.append(lam)
+        stab.append(bool(np.all(np.abs(lam[1:]) < 1.0)))
+        modes.append(tuple(int(m) for m in ff.modes))
+        amps.append(orbit_amplitude(system_at(mu), x, T, method=sopt.method))
+    lams = np.array(lams)
+    # multiplier crossings of +1 / -1 between consecutive points
+    for i in range(len(mus) - 1):
+        for target, kind in ((1.0, "multiplier_+1"), (-1.0, "period_doubling")):
+            a = _nontrivial_near(lams[i], target)
+            b = _nontrivial_near(lams[i + 1], target)
+            if abs(a.imag) < 1e-9 and abs(b.imag) < 1e-9 and np.sign(a.real - target) != np.sign(b.real - target):
+                lo_mu, hi_mu = sorted((mus[i], mus[i + 1]))
+                w = (target - a.real) / (b.real - a.real)
+                special.append(SpecialPoint(kind, i, mus[i] + w * (mus[i + 1] - mus[i]), (lo_mu, hi_mu),
+                                            hi_mu - lo_mu, {"multiplier_before": a.real, "multiplier_after": b.real}))
+    special.sort(key=lambda s: s.index)
+    return Branch(param, np.array(mus), np.array(Ts), np.array(amps), lams, np.array(stab), np.array(xs), modes,
+                  special, status, message)
+
+
+def _refine_fold(correct, tangent, unpack, v0, t0, ds, opt, index):
+    """Bisect the arclength step from (v0, t0) until the tangent's parameter component is ~0."""
+    a, b = 0.0, ds
+    best = None
+    for _ in range(60):
+        mid = 0.5 * (a + b)
+        res = correct(v0 + mid * t0, t0)
+        if res is None:
+            b = mid
+            continue
+        v, J, fl, _ = res
+        tm = tangent(J, t0)
+        best = (v, tm)
+        if np.sign(tm[-1]) == np.sign(t0[-1]):
+            a = mid
+        else:
+            b = mid
+        mu_a = unpack(v0 + a * t0)[2]
+        mu_b = unpack(v0 + b * t0)[2]
+        if abs(b - a) < 1e-10 or abs(mu_b - mu_a) < opt.fold_tol * max(abs(mu_a), 1e-12):
+            break
+    v = best[0] if best is not None else v0
+    mu = unpack(v)[2]
+    ra = correct(v0 + a * t0, t0)
+    rb = correct(v0 + b * t0, t0)
+    mus = [unpack(r[0])[2] for r in (ra, rb) if r is not None] or [mu]
+    lo_mu, hi_mu = min(mus + [mu]), max(mus + [mu])
+    x, T, _ = unpack(v)
+    return SpecialPoint("fold", index, float(mu), (lo_mu, hi_mu), hi_mu - lo_mu, {"period": float(T)})
+
+
+_ = shoot

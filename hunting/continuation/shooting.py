@@ -1,0 +1,194 @@
+"""Single shooting for periodic orbits of piecewise-smooth systems, Floquet multipliers.
+
+Unknowns: the initial state on a section x[i] = c (the phase condition) and the period T.
+Residual r = phi(T; x0) - x0; Newton's Jacobian [(Phi - I) without column i | f(phi(T))]
+uses the monodromy matrix with its saltation matrices, so unstable cycles converge as readily
+as stable ones.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ConvergenceError, Status, SystemDefinitionError
+from ..integrate.simulate import simulate
+from ..system import PiecewiseSystem
+from .flow import flow
+
+
+@dataclass(frozen=True)
+class ShootingOptions:
+    """tol : Newton stops when the scaled residual max|r_i| / scale_i <= tol (scale_i =
+    max(|x0_i|, floor)); max_iter : Newton iterations; rtol, atol, method : integration;
+    floor : absolute floor of the state scales."""
+
+    tol: float = 1e-9
+    max_iter: int = 30
+    rtol: float = 1e-11
+    atol: float = 1e-13
+    method: str = "dop853"
+    floor: float = 1e-6
+    max_events: int = 10_000
+    max_steps: int = 1_000_000
+
+    def __post_init__(self):
+        for name in ("tol", "rtol", "atol", "floor"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise SystemDefinitionError(f"{name} = {v!r} is not allowed: it must be a finite number > 0")
+        if self.method not in ("dop853", "dp5", "radau"):
+            raise SystemDefinitionError(f"method = {self.method!r} is not allowed: use dop853, dp5 or radau")
+
+
+@dataclass(frozen=True)
+class PeriodicOrbit:
+    """A periodic orbit.
+
+    x0 : (n,) state on the section; period : T [s]; modes : the mode sequence over one period;
+    event_times : (k,) within [0, T]; monodromy : (n, n); multipliers : (n,) complex, the trivial
+    one first, then by decreasing modulus; trivial_error : |lambda_trivial - 1|; amplitude :
+    max |x1| over the orbit; stable : every non-trivial |lambda| < 1; status, message;
+    iterations : Newton iterations; residual : final scaled residual."""
+
+    x0: np.ndarray
+    period: float
+    modes: tuple
+    event_times: np.ndarray
+    monodromy: np.ndarray
+    multipliers: np.ndarray
+    trivial_error: float
+    amplitude: float
+    stable: bool
+    status: Status
+    message: str
+    iterations: int
+    residual: float
+    params: np.ndarray = field(repr=False, default=None)
+
+    @property
+    def success(self) -> bool:
+        return self.status == Status.SUCCESS
+
+    @property
+    def nontrivial(self) -> np.ndarray:
+        return self.multipliers[1:]
+
+
+def floquet(M: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, float]:
+    """Multipliers of a monodromy matrix, the trivial one (eigenvector along the flow f) first,
+    the others by decreasing modulus; and |lambda_trivial - 1|."""
+    lam, vec = np.linalg.eig(M)
+    fn = f / max(np.linalg.norm(f), 1e-300)
+    align = np.abs(np.conj(vec.T) @ fn) / np.maximum(np.linalg.norm(vec, axis=0), 1e-300)
+    # the trivial multiplier: eigenvector along f, among those near 1
+    score = align - 0.1 * np.abs(lam - 1.0)
+    k = int(np.argmax(score))
+    rest = np.delete(lam, k)
+    rest = rest[np.argsort(-np.abs(rest))]
+    return np.concatenate([[lam[k]], rest]), float(abs(lam[k] - 1.0))
+
+
+def orbit_amplitude(system: PiecewiseSystem, x0, T, params=None, n: int = 4001, method="dop853") -> float:
+    """max |x1| over one period, from output at n points plus every event state."""
+    sys_ = system if params is None else system.with_param_array(params)
+    tr = simulate(sys_, x0, (0.0, T), t_eval=np.linspace(0.0, T, n), rtol=1e-10, atol=1e-13, method=method)
+    a = np.max(np.abs(tr.x[:, 0]))
+    if len(tr.events):
+        a = max(a, np.max(np.abs(tr.events.x_before[:, 0])))
+    return float(a)
+
+
+def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
+          options: ShootingOptions | None = None, throw: bool = False) -> PeriodicOrbit:
+    """Converge on a periodic orbit from a guess (x0, T); x0[section] stays fixed (phase
+    condition: the section x[section] = x0[section], e.g. x1 = 0 with x2 > 0)."""
+    opt = options or ShootingOptions()
+    x = system.check_state(x0).copy()
+    n = system.n_states
+    if not 0 <= section < n:
+        raise SystemDefinitionError(f"section = {section!r} is not a state index 0..{n - 1}")
+    if not (np.isfinite(T) and T > 0):
+        raise SystemDefinitionError(f"T = {T!r} is not allowed: the period guess must be > 0")
+    p = system.params if params is None else np.ascontiguousarray(params, dtype=float)
+    free = [i for i in range(n) if i != section]
+    scale = np.append(np.maximum(np.maximum(np.abs(x), 0.1 * np.max(np.abs(x))), opt.floor), max(T, 1e-12))
+    T = float(T)
+    kw = dict(params=p, method=opt.method, rtol=opt.rtol, atol=opt.atol, max_events=opt.max_events,
+              max_steps=opt.max_steps)
+
+    def evaluate(xv, Tv):
+        fl = flow(system, xv, Tv, **kw)
+        return fl, (fl.x - xv)
+
+    fl, r = evaluate(x, T)
+    status, message = Status.SUCCESS, "converged"
+    it = 0
+    res = np.inf
+    for it in range(1, opt.max_iter + 1):
+        if not fl.ok:
+            status, message = fl.status, f"integration failed at iteration {it}: {fl.status.name}"
+            break
+        res = float(np.max(np.abs(r) / scale[:n]))
+        if res <= opt.tol:
+            break
+        A = np.column_stack([(fl.Phi - np.eye(n))[:, free], fl.f])
+        try:
+            dz = np.linalg.solve(A, -r)
+        except np.linalg.LinAlgError:
+            status, message = Status.NEWTON_FAILED, "singular shooting Jacobian (is the orbit grazing a switching surface?)"
+            break
+        lam = 1.0
+        for _ in range(12):
+            xn = x.copy()
+            xn[free] += lam * dz[:-1]
+            Tn = T + lam * dz[-1]
+            if Tn > 0:
+                fln, rn = evaluate(xn, Tn)
+                if fln.ok and np.max(np.abs(rn) / scale[:n]) < (1 - 0.25 * lam) * res + 1e-300:
+                    break
+            lam *= 0.5
+        else:
+            status, message = Status.NEWTON_FAILED, f"damped Newton could not reduce the residual ({res:.3g}) at iteration {it}"
+            break
+        x, T, fl, r = xn, Tn, fln, rn
+    else:
+        status, message = Status.NEWTON_FAILED, f"no convergence in {opt.max_iter} iterations (residual {res:.3g}): improve the guess"
+    if status == Status.SUCCESS:
+        res = float(np.max(np.abs(r) / scale[:n]))
+        if res > opt.tol:
+            status, message = Status.NEWTON_FAILED, f"residual {res:.3g} above tol {opt.tol:.3g}"
+    mult, triv = (floquet(fl.Phi, fl.f) if fl.ok else (np.full(n, np.nan + 0j), np.nan))
+    amp = orbit_amplitude(system, x, T, p, method=opt.method) if status == Status.SUCCESS else np.nan
+    stable = bool(np.all(np.abs(mult[1:]) < 1.0)) if status == Status.SUCCESS else False
+    orbit = PeriodicOrbit(x, float(T), tuple(int(m) for m in fl.modes), fl.event_times, fl.Phi, mult, triv, amp,
+                          stable, status, message, it, res, p)
+    if throw and status != Status.SUCCESS:
+        raise ConvergenceError(f"{system.name}: shooting failed: {message}", orbit)
+    return orbit
+
+
+def cycle_guess(system: PiecewiseSystem, x0, *, t_settle: float, section: int = 0, params=None,
+                method: str = "dop853", max_time: float = 1e4) -> tuple[np.ndarray, float]:
+    """A starting guess for shooting: simulate from x0 for t_settle, then find two successive
+    upward crossings of x[section] = 0 (with the velocity state x[1] > 0); returns (state at the
+    second crossing, time between them)."""
+    sys_ = system if params is None else system.with_param_array(params)
+    tr = simulate(sys_, x0, (0.0, t_settle), method=method, rtol=1e-10, atol=1e-13)
+    x = tr.x_final
+    t_end = min(max_time, 50 * t_settle + 100.0)
+    tr = simulate(sys_, x, (0.0, t_end), method=method, rtol=1e-10, atol=1e-13, t_eval=np.linspace(0, t_end, 200001))
+    s = tr.x[:, section]
+    up = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0) & (tr.x[1:, 1] > 0))
+    if up.size < 3:
+        raise ConvergenceError(f"{system.name}: no periodic crossing of x{section + 1} = 0 found after "
+                               f"t_settle = {t_settle}: the motion may settle (no hunting) — try another start", tr)
+    i, j = up[-2], up[-1]
+    # refine the crossing by linear interpolation, then re-simulate to it exactly
+    def cross(k):
+        a, b = s[k], s[k + 1]
+        return tr.t[k] + (tr.t[k + 1] - tr.t[k]) * (-a) / (b - a)
+    t1, t2 = cross(i), cross(j)
+    x1 = simulate(sys_, x, (0.0, t1), method=method, rtol=1e-10, atol=1e-13).x_final.copy()
+    x1[section] = 0.0
+    return x1, float(t2 - t1)
