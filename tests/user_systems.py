@@ -177,3 +177,37 @@ def ball_system(g=9.81, e=0.5):
     return PiecewiseSystem(name="ball", state_names=("h", "v"), modes=("flight",), guard_names=("floor",),
                            param_names=("g", "e"), params=np.array([g, e]), vector_field=ball_vf,
                            guards=ball_guards, transition=ball_reset, mode_of=ball_mode)
+
+
+# ---------------------------------------------------------------- Hopf normal form (known cycle)
+# x' = x - w y - x r^2, y' = w x + y - y r^2: limit cycle r = 1, period 2 pi / w, non-trivial
+# Floquet multiplier exp(-2 * 2 pi / w). Two modes split at x = 0 with the same field, so the
+# events and their (identity) saltation matrices are exercised.
+@numba.njit(VF_SIG, cache=True, error_model="numpy", _nrt=False)
+def hopf_vf(mode, t, x, p, out):
+    r2 = x[0] * x[0] + x[1] * x[1]
+    out[0] = x[0] - p[0] * x[1] - x[0] * r2
+    out[1] = p[0] * x[0] + x[1] - x[1] * r2
+
+
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy", _nrt=False)
+def hopf_guards(mode, t, x, p, out):
+    out[0] = x[0] if mode == 0 else -x[0]
+
+
+@numba.njit(RESET_SIG, cache=True, error_model="numpy", _nrt=False)
+def hopf_reset(mode, guard, t, x, p, x_out):
+    x_out[0] = x[0]
+    x_out[1] = x[1]
+    return 1 - mode
+
+
+@numba.njit(MODE_SIG, cache=True, error_model="numpy", _nrt=False)
+def hopf_mode(t, x, p):
+    return 0 if x[0] > 0 or (x[0] == 0 and x[1] < 0) else 1
+
+
+def hopf_system(w=2.0):
+    return PiecewiseSystem(name="hopf", state_names=("x", "y"), modes=("x>0", "x<0"), guard_names=("x = 0",),
+                           param_names=("w",), params=np.array([w]), vector_field=hopf_vf, guards=hopf_guards,
+                           transition=hopf_reset, mode_of=hopf_mode)

@@ -247,16 +247,27 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         modes.append(tuple(int(m) for m in ff.modes))
         amps.append(orbit_amplitude(system_at(mu), x, T, method=sopt.method))
     lams = np.array(lams)
-    # multiplier crossings of +1 / -1 between consecutive points
+    # multiplier crossings: changes in the number of non-trivial multipliers outside the unit
+    # circle through +1 (fold), through -1 (period doubling) or as a complex pair (torus)
+    def counts(lam):
+        rest = lam[1:]
+        real = np.abs(rest.imag) < 1e-9 * np.maximum(1.0, np.abs(rest))
+        return (int(np.sum(real & (rest.real > 1))), int(np.sum(real & (rest.real < -1))),
+                int(np.sum(~real & (np.abs(rest) > 1))))
     for i in range(len(mus) - 1):
-        for target, kind in ((1.0, "multiplier_+1"), (-1.0, "period_doubling")):
-            a = _nontrivial_near(lams[i], target)
-            b = _nontrivial_near(lams[i + 1], target)
-            if abs(a.imag) < 1e-9 and abs(b.imag) < 1e-9 and np.sign(a.real - target) != np.sign(b.real - target):
+        ca, cb = counts(lams[i]), counts(lams[i + 1])
+        for j, kind, target in ((0, "multiplier_+1", 1.0), (1, "period_doubling", -1.0), (2, "torus", None)):
+            if ca[j] != cb[j]:
                 lo_mu, hi_mu = sorted((mus[i], mus[i + 1]))
-                w = (target - a.real) / (b.real - a.real)
-                special.append(SpecialPoint(kind, i, mus[i] + w * (mus[i + 1] - mus[i]), (lo_mu, hi_mu),
-                                            hi_mu - lo_mu, {"multiplier_before": a.real, "multiplier_after": b.real}))
+                data = {"unstable_before": ca[j], "unstable_after": cb[j]}
+                est = 0.5 * (mus[i] + mus[i + 1])
+                if target is not None:
+                    a = _nontrivial_near(lams[i], target).real
+                    b = _nontrivial_near(lams[i + 1], target).real
+                    if a != b and (a - target) * (b - target) <= 0:
+                        est = mus[i] + (target - a) / (b - a) * (mus[i + 1] - mus[i])
+                    data.update(multiplier_before=a, multiplier_after=b)
+                special.append(SpecialPoint(kind, i, float(est), (lo_mu, hi_mu), hi_mu - lo_mu, data))
     special.sort(key=lambda s: s.index)
     return Branch(param, np.array(mus), np.array(Ts), np.array(amps), lams, np.array(stab), np.array(xs), modes,
                   special, status, message)

@@ -192,3 +192,30 @@ def cycle_guess(system: PiecewiseSystem, x0, *, t_settle: float, section: int = 
     x1 = simulate(sys_, x, (0.0, t1), method=method, rtol=1e-10, atol=1e-13).x_final.copy()
     x1[section] = 0.0
     return x1, float(t2 - t1)
+
+
+def guess_from_stick_error(loop, d: float, *, section: int = 0) -> tuple[np.ndarray, float]:
+    """A shooting guess for the symmetric stick-slip cycle with stick error |d| (a fixed point of
+    the event map): start at the break-away state of -|d|, find the first upward crossing of
+    x[section] = 0 and the time to the next one (Switch loops with an exact stick mode)."""
+    from ..eventmap.engine import evaluate_map
+    d = -abs(float(d))
+    mv = evaluate_map(loop, [d], 2)
+    if not mv.ok[0]:
+        raise ConvergenceError(f"{loop.name}: the event map failed at d = {d}", mv)
+    mv1 = evaluate_map(loop, [d], 1)
+    period = float(mv.slip_time[0] + mv1.stick_time[0] + mv.stick_time[0])
+    X0, mode0 = loop.breakaway_state([d])
+    n_out = 400001
+    t_end = 2.2 * period
+    tr = simulate(loop.system, X0[0], (0.0, t_end), mode0=int(mode0[0]), rtol=1e-11, atol=1e-14,
+                  t_eval=np.linspace(0.0, t_end, n_out))
+    s = tr.x[:, section]
+    up = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0) & (tr.x[1:, 1] > 0))
+    if up.size < 2:
+        raise ConvergenceError(f"{loop.name}: no two upward crossings of x{section + 1} = 0 from d = {d}", tr)
+    k = up[0]
+    t1 = tr.t[k] + (tr.t[k + 1] - tr.t[k]) * (-s[k]) / (s[k + 1] - s[k])
+    x1 = simulate(loop.system, X0[0], (0.0, t1), mode0=int(mode0[0]), rtol=1e-12, atol=1e-15).x_final.copy()
+    x1[section] = 0.0
+    return x1, period

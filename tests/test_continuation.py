@@ -1,0 +1,97 @@
+"""Sensitivities with saltation matrices, shooting, Floquet multipliers, continuation."""
+import math
+
+import numpy as np
+import pytest
+
+import hunting
+from hunting.continuation import ContinuationOptions, continue_orbit, cycle_guess, fd_jacobian, flow, shoot
+from hunting.continuation.shooting import guess_from_stick_error
+from hunting.eventmap import fixed_points
+from hunting.models import preset
+from user_systems import hopf_system
+
+
+@pytest.mark.parametrize("name,kw,x0,T,method", [
+    ("table9.1", {}, [0.1, -0.2, 0.03], 2.5, "dop853"),                      # stick entry and exit
+    ("table9.1", dict(beta="inf"), [0.1, -0.2, 0.03], 2.5, "dop853"),        # exit with a jump in f
+    ("table9.1", dict(P=100.0, D=0.01), [0.5, 0.1, 0.0], 0.6, "dop853"),     # reversals without stick
+    ("table9.1", dict(model="switch-banded", eta=1e-3), [0.1, -0.2, 0.03], 2.5, "dop853"),
+    ("table8.1-lugre", dict(K=0.3), [-0.02, 0.05, 0.01, 1e-5], 0.5, "dop853"),  # kinks at x2 = 0
+    ("table8.1-lugre", dict(K=0.3), [-0.02, 0.05, 0.01, 1e-5], 0.5, "radau"),
+    ("limms-switch", {}, [0.004, -0.05, 0.001], 4.0, "dop853"),                # cogging
+])
+def test_monodromy_matches_finite_differences_of_the_flow(name, kw, x0, T, method):
+    sys_ = preset(name, **kw).system
+    fl = flow(sys_, x0, T, method=method, rtol=1e-11, atol=1e-14)
+    assert fl.ok and len(fl.event_times) >= 2
+    J = fd_jacobian(sys_, x0, T, rel=1e-6, rtol=1e-12, atol=1e-15)
+    assert np.abs(fl.Phi - J).max() <= 1e-6 * np.abs(J).max()
+
+
+def test_stick_entry_projects_out_the_velocity():
+    """Entering stick makes d x2 / d x0 vanish: a multiplier 0 (thesis chapter 8)."""
+    sys_ = preset("table9.1").system
+    fl = flow(sys_, [0.1, -0.2, 0.03], 1.2)          # ends inside a stick phase
+    assert fl.mode == 2 and np.all(fl.Phi[1] == 0.0)
+
+
+def test_floquet_multipliers_of_a_known_limit_cycle():
+    sys_ = hopf_system(w=2.0)
+    po = shoot(sys_, [0.0, -1.05], 3.0, section=0)
+    assert po.success
+    assert po.period == pytest.approx(math.pi, abs=1e-9)
+    assert np.hypot(*po.x0) == pytest.approx(1.0, abs=1e-9)
+    assert po.trivial_error < 1e-8
+    assert po.multipliers[1].real == pytest.approx(math.exp(-2 * math.pi), rel=1e-6)   # exp(-2 T), T = pi
+    assert po.stable and po.amplitude == pytest.approx(1.0, abs=1e-6)
+
+
+def _switch_cycle(K):
+    lp = preset("table8.1-switch", K=K)
+    d = next(f.d for f in fixed_points(lp, np.linspace(0.0, 0.01, 401), 2) if f.kind == "cycle" and f.stable)
+    x0, T = guess_from_stick_error(lp, d)
+    return lp, shoot(lp.system, x0, T)
+
+
+def test_cycle_guess_from_a_long_simulation():
+    lp = preset("table8.1-switch", K=0.3)
+    x0, T = cycle_guess(lp.system, lp.state(x1=-1.0), t_settle=100.0)
+    po = shoot(lp.system, x0, T)
+    assert po.success and po.period == pytest.approx(14.3081346, rel=1e-6)
+
+
+def test_switch_cycle_is_the_event_map_fixed_point_and_multiplier_is_its_slope():
+    lp, po = _switch_cycle(0.3)
+    assert po.success and po.stable and po.trivial_error < 1e-8
+    lam = sorted(np.abs(po.multipliers[1:]))
+    assert lam[0] < 1e-10                                  # stick: multiplier 0
+    fps = fixed_points(lp, np.linspace(0.0, 0.01, 401), 2)
+    cyc = next(f for f in fps if f.kind == "cycle" and f.stable)
+    assert po.amplitude == pytest.approx(cyc.d, rel=1e-7)  # max |x1| is the stick error
+    assert lam[1] == pytest.approx(cyc.slope, rel=1e-5)    # multiplier = slope of P^2 at d*
+
+
+def test_shooting_converges_on_an_unstable_cycle():
+    lp = preset("table8.1-switch", K=0.634)
+    fps = fixed_points(lp, np.linspace(0.0, 0.01, 1001), 2)
+    d_u = next(f for f in fps if f.kind == "cycle" and not f.stable)
+    x0, T = guess_from_stick_error(lp, d_u.d)
+    po = shoot(lp.system, x0, T)
+    assert po.success and not po.stable
+    assert po.amplitude == pytest.approx(d_u.d, rel=1e-6)
+    assert max(abs(po.multipliers[1:])) == pytest.approx(d_u.slope, rel=1e-4)
+
+
+def test_continuation_finds_the_switch_fold():
+    lp, po = _switch_cycle(0.6)
+    base = lp.system
+    br = continue_orbit(lambda K: base.with_param_array(preset("table8.1-switch", K=K).system.params), po, 0.6,
+                        0.7, param="K", options=ContinuationOptions(max_points=60))
+    folds = [s for s in br.special if s.kind == "fold"]
+    assert folds and folds[0].param == pytest.approx(0.647, rel=5e-3) and folds[0].precision < 1e-6
+    crossing = [s for s in br.special if s.kind == "multiplier_+1"]
+    assert crossing and abs(crossing[0].param - folds[0].param) < 1e-4
+    # stable before the fold, unstable after
+    i = folds[0].index
+    assert br.stable[: i + 1].all() and not br.stable[i + 2:].any()
