@@ -152,3 +152,20 @@ def nonpassive_intervals(curve, b_star: float, v) -> list:
             out.append((float(v[start]), float(v[end])))
             start = None
     return out
+
+
+def lugre_equilibrium_eigenvalues(loop: ServoLoop, beta_frac: float, q: float) -> np.ndarray:
+    """Eigenvalues of the generalized (Clarke) Jacobian (1 - q) J- + q J+ of the LuGre loop at
+    the equilibrium x = beta [0, 0, -sigma0/(cm ki), 1] (x3 from the integral action balancing
+    sigma0 beta; thesis sections 4.3, 8.4.1), beta = beta_frac * Fs / sigma0."""
+    from .models import servo as S
+    from .models.friction import LuGre
+    if not isinstance(loop.friction, LuGre):
+        raise SystemDefinitionError(f"{loop.name}: the generalized Jacobian applies to LuGre loops")
+    beta = beta_frac * loop.friction.curve.positive.Fs / loop.friction.sigma0
+    x = np.array([0.0, 0.0, -loop.friction.sigma0 * beta / (loop.plant.motor_constant * loop.controller.ki), beta])
+    p = loop.system.params
+    Jp, Jm = np.empty((4, 4)), np.empty((4, 4))
+    S.servo_jac(S.V_POS, 0.0, x, p, Jp)
+    S.servo_jac(S.V_NEG, 0.0, x, p, Jm)
+    return np.linalg.eigvals((1.0 - q) * Jm + q * Jp)

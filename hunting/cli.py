@@ -4,7 +4,9 @@
     hunting simulate PRESET [--set NAME=VALUE ...] [--x0 X1,X2,X3] [--t T] [--json F] [--plot F]
     hunting eventmap PRESET [--set NAME=VALUE ...] --grid START:STOP:N [--iterate K]
                      [--json FILE] [--plot FILE]
-    hunting reproduce ch9 [--out DIR]   a thesis chapter: tables and figures, checked
+    hunting continue PRESET [--set NAME=VALUE ...] --param NAME --from A --to B [--back-to C]
+                     [--json FILE] [--plot FILE]
+    hunting reproduce ch8|ch9 [--out DIR]   a thesis chapter: tables and figures, checked
     hunting demo [--out DIR]            short simulations of chapters 4, 8 and 9, checked
 """
 from __future__ import annotations
@@ -95,9 +97,27 @@ def _cmd_eventmap(args) -> int:
     return 0
 
 
+def _cmd_continue(args) -> int:
+    from .continuation import follow
+    from .plotting import plot_branch
+    sets = _parse_sets(args.set)
+    if args.param in sets:
+        raise HuntingError(f"--param {args.param} is also given in --set: remove it there")
+    br = follow(args.preset, args.param, args.start, args.end, overrides=sets,
+                stop_at=args.back_to if args.back_to is not None else args.start)
+    print(f"{len(br.mu)} points, {br.message}")
+    for s in br.special:
+        print(f"{s.kind:<16} {args.param} = {s.param:.8g}  (interval width {s.precision:.2g})")
+    if args.json:
+        Path(args.json).write_text(json.dumps(br.as_dict(), indent=1))
+    if args.plot:
+        plot_branch(br, title=f"{args.preset}: hunting branch in {args.param}", path=args.plot)
+    return 0
+
+
 def _cmd_reproduce(args) -> int:
     import importlib
-    chapters = {"ch9": "hunting.reproduce.ch9"}
+    chapters = {"ch8": "hunting.reproduce.ch8", "ch9": "hunting.reproduce.ch9"}
     if args.chapter not in chapters:
         raise HuntingError(f"chapter {args.chapter!r} is not available: choose from {sorted(chapters)}")
     mod = importlib.import_module(chapters[args.chapter])
@@ -128,15 +148,25 @@ def main(argv=None) -> int:
     ep.add_argument("--iterate", type=int, default=1)
     ep.add_argument("--json")
     ep.add_argument("--plot")
+    cp = sub.add_parser("continue", help="follow the hunting branch in one parameter (shooting + arclength)")
+    cp.add_argument("preset")
+    cp.add_argument("--set", action="append", metavar="NAME=VALUE")
+    cp.add_argument("--param", required=True)
+    cp.add_argument("--from", dest="start", type=float, required=True)
+    cp.add_argument("--to", dest="end", type=float, required=True)
+    cp.add_argument("--back-to", dest="back_to", type=float, default=None,
+                    help="after a fold, follow the branch back until the parameter reaches this value")
+    cp.add_argument("--json")
+    cp.add_argument("--plot")
     rp = sub.add_parser("reproduce", help="reproduce a thesis chapter (tables, figures, checks)")
-    rp.add_argument("chapter", help="ch9")
+    rp.add_argument("chapter", help="ch8 or ch9")
     rp.add_argument("--out")
     dp = sub.add_parser("demo", help="hunting cycles of chapters 8 and 9, checked against the thesis")
     dp.add_argument("--out", default="out/demo")
     args = ap.parse_args(argv)
     try:
         return {"models": _cmd_models, "simulate": _cmd_simulate, "eventmap": _cmd_eventmap,
-                "reproduce": _cmd_reproduce, "demo": _cmd_demo}[args.cmd](args)
+                "continue": _cmd_continue, "reproduce": _cmd_reproduce, "demo": _cmd_demo}[args.cmd](args)
     except HuntingError as e:
         print(f"hunting: error: {e}", file=sys.stderr)
         return 2

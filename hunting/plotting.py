@@ -170,3 +170,93 @@ def plot_map_diagram(diagram, *, title: str = "", ax=None, path=None, unit: str 
         if path is not None:
             fig.savefig(path, dpi=130)
     return fig
+
+
+def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "rad", equilibrium_stable=None):
+    """Bifurcation diagram of a branch of periodic orbits (amplitude max|x1| against the
+    parameter; stable solid, unstable dashed; folds marked) above its Floquet multipliers
+    (real parts; the trivial one dotted). ``equilibrium_stable``: optional (mu, stable) arrays
+    to draw the equilibrium set x1 = 0."""
+    plt = _plt()
+    if axes is None:
+        fig, axes = plt.subplots(2, 1, figsize=(7.0, 7.0), sharex=True, gridspec_kw=dict(height_ratios=[3, 2]))
+    else:
+        fig = axes[0].figure
+    ax, axm = axes
+    mu, amp, st = branch.mu, branch.amplitude, branch.stable
+    start = 0
+    for i in range(1, len(mu) + 1):
+        if i == len(mu) or st[i] != st[start]:
+            sl = slice(start, min(i + 1, len(mu)))
+            ax.plot(mu[sl], amp[sl], "-" if st[start] else "--", color="k", lw=1.5 if st[start] else 1.1)
+            start = i
+    if equilibrium_stable is not None:
+        emu, est = equilibrium_stable
+        ax.plot(emu, np.zeros_like(emu), "-" if np.all(est) else "--", color="C0", lw=2.0,
+                label="equilibrium set (x1 = 0)")
+    for s in branch.special:
+        if s.kind == "fold":
+            i = min(s.index + 1, len(mu) - 1)
+            ax.plot(s.param, amp[i], "s", color="C3", ms=7, label=f"cyclic fold {branch.param} = {s.param:.4f}")
+    ax.plot([], [], "-", color="k", label="stable cycles")
+    ax.plot([], [], "--", color="k", label="unstable cycles")
+    folds = [s for s in branch.special if s.kind == "fold"]
+    if folds:   # magnified view of the fold, where the unstable branch starts
+        k0 = folds[0].param
+        sel = np.abs(mu - k0) < 0.03 * abs(k0) + 1e-12
+        if sel.sum() > 3:
+            ins = ax.inset_axes([0.45, 0.35, 0.5, 0.4])
+            start = 0
+            idx = np.flatnonzero(sel)
+            m2, a2, s2 = mu[idx], amp[idx], st[idx]
+            for i in range(1, len(m2) + 1):
+                if i == len(m2) or s2[i] != s2[start]:
+                    sl = slice(start, min(i + 1, len(m2)))
+                    ins.plot(m2[sl], a2[sl], "-" if s2[start] else "--", color="k", lw=1.2)
+                    start = i
+            ins.plot(k0, amp[min(folds[0].index + 1, len(mu) - 1)], "s", color="C3", ms=5)
+            ins.tick_params(labelsize=7)
+            ins.grid(alpha=0.3)
+            ins.set_title("near the fold", fontsize=7)
+    ax.set_ylabel(f"max |x1| [{unit}]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    lam = branch.multipliers
+    for j in range(lam.shape[1]):
+        axm.plot(mu, lam[:, j].real, ":" if j == 0 else "-", lw=1.0, label=f"lambda{j + 1}")
+    axm.axhline(1.0, color="0.5", lw=0.6)
+    axm.set_ylim(-0.5, 3.0)
+    axm.set_xlabel(branch.param)
+    axm.set_ylabel("Floquet multipliers (real)")
+    axm.grid(alpha=0.3)
+    axm.legend(fontsize=8, ncol=4)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        fig.savefig(path, dpi=130)
+    return fig
+
+
+def plot_cycles(system, orbits, labels, *, title: str = "", path=None, eq_bounds=None):
+    """Periodic orbits in (x1, x2, x3), with the equilibrium set segment on the x3 axis."""
+    from .integrate.simulate import simulate
+    plt = _plt()
+    fig = plt.figure(figsize=(6.5, 5.5))
+    ax = fig.add_subplot(projection="3d")
+    for po, lab, style in zip(orbits, labels, ("-", "--", ":")):
+        tr = simulate(system.with_param_array(po.params), po.x0, (0.0, po.period),
+                      t_eval=np.linspace(0.0, po.period, 3001), rtol=1e-10, atol=1e-13)
+        ax.plot(tr.x[:, 0], tr.x[:, 1], tr.x[:, 2], style, color="k", lw=1.0, label=lab)
+    if eq_bounds is not None:
+        ax.plot([0, 0], [0, 0], list(eq_bounds), "-", color="C0", lw=3, label="equilibrium set")
+    ax.set_xlabel("x1")
+    ax.set_ylabel("x2")
+    ax.set_zlabel("x3")
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        fig.savefig(path, dpi=130)
+    return fig

@@ -95,3 +95,31 @@ def test_continuation_finds_the_switch_fold():
     # stable before the fold, unstable after
     i = folds[0].index
     assert br.stable[: i + 1].all() and not br.stable[i + 2:].any()
+
+
+def test_cli_continue_json_contract(tmp_path):
+    import json
+
+    from hunting.cli import main
+    js = tmp_path / "b.json"
+    assert main(["continue", "table8.1-switch", "--param", "K", "--from", "0.6", "--to", "0.7",
+                 "--back-to", "0.645", "--json", str(js), "--plot", str(tmp_path / "b.png")]) == 0
+    data = json.loads(js.read_text())
+    p = data["points"][0]
+    assert {"param", "period", "amplitude", "multipliers", "stable"} <= set(p)
+    assert len(p["multipliers"]) == 3 and len(p["multipliers"][0]) == 2
+    kinds = {s["kind"] for s in data["special_points"]}
+    assert "fold" in kinds
+    fold = next(s for s in data["special_points"] if s["kind"] == "fold")
+    assert fold["param"] == pytest.approx(0.6473391, abs=1e-6)
+
+
+def test_reproduce_ch8_matches_the_thesis(tmp_path):
+    import json
+
+    from hunting.reproduce.ch8 import run
+    assert run(tmp_path) == 0
+    data = json.loads((tmp_path / "ch8.json").read_text())
+    assert all(r["ok"] for r in data["checks"])
+    for k in (2, 3, 4, 5, 6):
+        assert any(tmp_path.glob(f"fig8_{k}*.png"))

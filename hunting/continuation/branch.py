@@ -37,7 +37,7 @@ class ContinuationOptions:
     max_points: int = 400
     newton_tol: float = 1e-9
     newton_max: int = 10
-    dmu: float = 1e-6
+    dmu: float = 1e-8
     fold_tol: float = 1e-7
     max_correction: float = 0.3
     step_tol: float = 1e-10
@@ -130,9 +130,14 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         r = fl.x - x
         if not need_jac:
             return r, None, fl
+        # d phi / d mu by central differences: it must be accurate to ~1e-7, because the
+        # extended system is as ill-conditioned as the orbit is unstable (a 1e-4 error in this
+        # column slowed Newton to a linear rate of 0.1 on the unstable branch); hence a small
+        # step and tight tolerances for these two flows
         h = opt.dmu * max(abs(mu), 1e-3)
-        fp = flow(system_at(mu + h), x, T, sensitivity=False, **kw)
-        fm = flow(system_at(mu - h), x, T, sensitivity=False, **kw)
+        kw_mu = dict(kw, rtol=min(sopt.rtol, 1e-13), atol=min(sopt.atol, 1e-16))
+        fp = flow(system_at(mu + h), x, T, sensitivity=False, **kw_mu)
+        fm = flow(system_at(mu - h), x, T, sensitivity=False, **kw_mu)
         if not (fp.ok and fm.ok):
             return None
         Fmu = (fp.x - fm.x) / (2 * h)

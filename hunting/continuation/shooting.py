@@ -158,6 +158,10 @@ def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
         res = float(np.max(np.abs(r) / scale[:n]))
         if res > opt.tol:
             status, message = Status.NEWTON_FAILED, f"residual {res:.3g} above tol {opt.tol:.3g}"
+        elif np.linalg.norm(fl.f) <= 1e-9 * max(np.linalg.norm(x), 1e-300) / T:
+            # a rest point is periodic for every T: not a cycle
+            status, message = Status.NEWTON_FAILED, ("converged to an equilibrium (the vector field vanishes "
+                                                     "on the orbit): start closer to the cycle")
     mult, triv = (floquet(fl.Phi, fl.f) if fl.ok else (np.full(n, np.nan + 0j), np.nan))
     amp = orbit_amplitude(system, x, T, p, method=opt.method) if status == Status.SUCCESS else np.nan
     stable = bool(np.all(np.abs(mult[1:]) < 1.0)) if status == Status.SUCCESS else False

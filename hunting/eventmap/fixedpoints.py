@@ -137,7 +137,17 @@ def _refine(loop, a, b, ga, gb, iterate, opt, tol, max_iter=200):
                     gb[k] *= 0.5
                 side[k] = -1
     use_b = np.abs(gb) < np.abs(ga)
-    return np.where(use_b, b, a)
+    return np.where(use_b, b, a), np.abs(gb - ga)
+
+
+def _slope(loop, d, k, opt) -> float:
+    """dP^k/dd at d: central differences with Richardson extrapolation (steps h and h/2), since
+    maps are strongly curved near folds and unstable cycles (slopes up to 1e8 in chapter 8)."""
+    h = opt.fd_step * max(abs(d), opt.d_floor)
+    pm = evaluate_map(loop, [d + h, d - h, d + h / 2, d - h / 2], k, opt)
+    d1 = (pm.image[0] - pm.image[1]) / (2 * h)
+    d2 = (pm.image[2] - pm.image[3]) / h
+    return float((4 * d2 - d1) / 3)
 
 
 def _thesis_fit(grid, image, i):
@@ -169,18 +179,25 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
     ok = em.ok
     i = np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(g[:-1]) * np.sign(g[1:]) < 0)
                        & (em.grid[:-1] * em.grid[1:] > 0))
-    roots = _refine(loop, em.grid[i], em.grid[i + 1], g[i], g[i + 1], iterate, opt, tol) if i.size else np.empty(0)
+    if i.size:
+        roots, jumps = _refine(loop, em.grid[i], em.grid[i + 1], g[i], g[i + 1], iterate, opt, tol)
+    else:
+        roots, jumps = np.empty(0), np.empty(0)
     exact = np.flatnonzero(ok & (g == 0) & (em.grid != 0))
     roots = np.concatenate([roots, em.grid[exact]])
+    jumps = np.concatenate([jumps, np.zeros(exact.size)])
     brackets = list(i) + [None] * exact.size
     out: list[FixedPoint] = []
     seen: list[np.ndarray] = []
     scale = max(np.max(np.abs(grid)), opt.d_floor)
-    for r, bi in zip(roots, brackets):
+    for r, bi, jump in zip(roots, brackets, jumps):
         res = evaluate_map(loop, [r], iterate, opt)
         resid = abs(res.image[0] - r)
-        if not res.ok[0] or resid > 1e-6 * max(abs(r), opt.d_floor):
-            continue                                   # a jump of the map, not a fixed point
+        # a sign change of P^k(d) - d across a bracket of width ~tol whose ends still differ by
+        # a finite amount is a jump of the map, not a fixed point (a steep root differs by
+        # slope * tol only: 3e-7 for the slope 3e5 of the unstable cycles of chapter 8)
+        if not res.ok[0] or jump > 1e-2 * max(abs(r), opt.d_floor):
+            continue
         orbit = [r]
         x = r
         for _ in range(iterate - 1):
@@ -196,9 +213,7 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
             continue
         seen.append(orbit)
         rep = float(orbit[np.argmax(orbit)])
-        h = opt.fd_step * max(abs(rep), opt.d_floor)
-        pm = evaluate_map(loop, [rep + h, rep - h], k, opt)
-        slope = float((pm.image[0] - pm.image[1]) / (2 * h))
+        slope = _slope(loop, rep, k, opt)
         fit_d = fit_s = None
         if thesis_fits and bi is not None and rep == r:
             fit_d, fit_s = _thesis_fit(em.grid, em.image, bi)
