@@ -205,7 +205,7 @@ def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "r
         k0 = folds[0].param
         sel = np.abs(mu - k0) < 0.03 * abs(k0) + 1e-12
         if sel.sum() > 3:
-            ins = ax.inset_axes([0.45, 0.35, 0.5, 0.4])
+            ins = ax.inset_axes([0.45, 0.22, 0.5, 0.4])
             start = 0
             idx = np.flatnonzero(sel)
             m2, a2, s2 = mu[idx], amp[idx], st[idx]
