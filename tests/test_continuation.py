@@ -123,3 +123,21 @@ def test_reproduce_ch8_matches_the_thesis(tmp_path):
     assert all(r["ok"] for r in data["checks"])
     for k in (2, 3, 4, 5, 6):
         assert any(tmp_path.glob(f"fig8_{k}*.png"))
+
+
+def test_unstable_cycle_of_a_piecewise_linear_relay_oscillator():
+    """Closed forms: period 2 pi / w, multipliers 1 and e^(2k), amplitude F (1 + e^k)/(e^k - 1);
+    the velocity jumps at y = 0 make non-trivial saltation matrices."""
+    from user_systems import relay_system
+    delta, F = 0.1, 1.0
+    w = math.sqrt(1 - delta ** 2)
+    k = delta * math.pi / w
+    a = F * (1 + math.exp(k)) / (math.exp(k) - 1)
+    sys_ = relay_system(delta, F)
+    # guess: a point near x = 0 on the upper half of the cycle
+    po = shoot(sys_, [0.0, 0.97 * math.sqrt(a * a - F * F) + 0.0], 2 * math.pi / w * 1.01, section=0)
+    assert po.success and not po.stable
+    assert po.period == pytest.approx(2 * math.pi / w, rel=1e-9)
+    assert po.amplitude == pytest.approx(a, rel=1e-6)
+    assert po.trivial_error < 1e-8
+    assert abs(po.multipliers[1]) == pytest.approx(math.exp(2 * k), rel=1e-8)

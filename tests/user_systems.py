@@ -211,3 +211,40 @@ def hopf_system(w=2.0):
     return PiecewiseSystem(name="hopf", state_names=("x", "y"), modes=("x>0", "x<0"), guard_names=("x = 0",),
                            param_names=("w",), params=np.array([w]), vector_field=hopf_vf, guards=hopf_guards,
                            transition=hopf_reset, mode_of=hopf_mode)
+
+
+# ---------------------------------------------------------------- relay oscillator (known cycle)
+# x' = y, y' = -x + 2 delta y - F sgn(y): linear in each half plane, spirals out around (-F sgn y, 0).
+# Symmetric cycle: amplitude a = F (1 + e^k) / (e^k - 1), k = delta pi / w, w = sqrt(1 - delta^2),
+# period 2 pi / w, multipliers 1 and e^(2k) (unstable); the crossings of y = 0 have saltation
+# matrices diag(1, (a - F)/(a + F)) (a jump of 2F in y').
+@numba.njit(VF_SIG, cache=True, error_model="numpy", _nrt=False)
+def relay_vf(mode, t, x, p, out):
+    s = 1.0 if mode == 0 else -1.0
+    out[0] = x[1]
+    out[1] = -x[0] + 2.0 * p[0] * x[1] - p[1] * s
+
+
+@numba.njit(GUARD_SIG, cache=True, error_model="numpy", _nrt=False)
+def relay_guards(mode, t, x, p, out):
+    out[0] = x[1] if mode == 0 else -x[1]
+
+
+@numba.njit(RESET_SIG, cache=True, error_model="numpy", _nrt=False)
+def relay_reset(mode, guard, t, x, p, x_out):
+    x_out[0] = x[0]
+    x_out[1] = 0.0
+    return 1 - mode
+
+
+@numba.njit(MODE_SIG, cache=True, error_model="numpy", _nrt=False)
+def relay_mode(t, x, p):
+    if x[1] != 0.0:
+        return 0 if x[1] > 0 else 1
+    return 0 if -x[0] > 0 else 1
+
+
+def relay_system(delta=0.1, F=1.0):
+    return PiecewiseSystem(name="relay", state_names=("x", "y"), modes=("y>0", "y<0"), guard_names=("y = 0",),
+                           param_names=("delta", "F"), params=np.array([delta, F]), vector_field=relay_vf,
+                           guards=relay_guards, transition=relay_reset, mode_of=relay_mode)
