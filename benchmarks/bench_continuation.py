@@ -12,6 +12,7 @@ AUTO-07p is not installed on this machine, so it is not compared here.
 """
 from __future__ import annotations
 
+import functools
 import time
 
 import numpy as np
@@ -22,7 +23,7 @@ from hunting.models import preset
 from hunting.models import servo as S
 
 
-def scipy_shoot(loop, x0, T, tol=1e-9, rtol=1e-10, atol=1e-13, max_iter=20):
+def scipy_shoot(loop, x0, T, tol=1e-9, rtol=1e-10, atol=1e-13, max_iter=8):
     p = loop.system.params
 
     def rhs(t, x):
@@ -41,26 +42,38 @@ def scipy_shoot(loop, x0, T, tol=1e-9, rtol=1e-10, atol=1e-13, max_iter=20):
     x = np.array(x0, float)
     n = x.size
     nint = 0
+    xT = phi(x, T)
+    nint += 1
     for it in range(max_iter):
-        xT = phi(x, T)
-        nint += 1
         r = xT - x
         scale = np.maximum(np.abs(x), 0.1 * np.max(np.abs(x)))
-        if np.max(np.abs(r) / scale) < tol:
+        res = np.max(np.abs(r) / scale)
+        if res < tol:
             return x, T, it, nint
         M = np.empty((n, n))
         for j in range(n):
-            h = 1e-7 * max(abs(x[j]), 1e-6)
+            h = 1e-6 * max(abs(x[j]), 1e-3 * np.max(np.abs(x[:3])) if j < 3 else 1e-3 * abs(x[3]) + 1e-9)
             xp = x.copy()
             xp[j] += h
             M[:, j] = (phi(xp, T) - xT) / h
             nint += 1
-        f = rhs(0, xT)
-        A = np.column_stack([(M - np.eye(n))[:, 1:], f])
+        A = np.column_stack([(M - np.eye(n))[:, 1:], rhs(0, xT)])
         dz = np.linalg.solve(A, -r)
-        x[1:] += dz[:-1]
-        T += dz[-1]
+        lam = 1.0
+        for _ in range(8):          # the same damping as hunting.shoot
+            xn = x.copy()
+            xn[1:] += lam * dz[:-1]
+            Tn = T + lam * dz[-1]
+            xTn = phi(xn, Tn)
+            nint += 1
+            if np.max(np.abs(xTn - xn) / scale) < (1 - 0.25 * lam) * res:
+                break
+            lam *= 0.5
+        x, T, xT = xn, Tn, xTn
     return x, T, max_iter, nint
+
+
+print = functools.partial(print, flush=True)  # noqa: A001
 
 
 def main() -> None:

@@ -6,8 +6,9 @@ one). Corrector: Newton on [F(u); t . (u - u_pred)] = 0 with the monodromy-based
 F_mu by central differences in mu. Step size grows after easy corrections and shrinks after
 failed ones. At every point: Floquet multipliers and stability. Special points: folds (mu
 turns back; a multiplier passes +1) located by bisection in arclength, period doublings
-(a multiplier passes -1) and changes in the event sequence (a stick phase or velocity
-reversal appears or vanishes: grazing).
+(a multiplier passes -1), tori (a complex pair leaves the unit circle) and "grazing": the
+event sequence of the orbit changes (a stick phase or a velocity reversal appears or vanishes),
+bracketed between two branch points with the event counts before and after.
 """
 from __future__ import annotations
 
@@ -222,7 +223,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             special.append(sp)
             turns += 1
         if tuple(fl_new.modes) != tuple(fl.modes) and len(fl_new.modes) != len(fl.modes):
-            special.append(SpecialPoint("event_sequence", len(pts_v) - 1, 0.5 * (unpack(v)[2] + mu_new),
+            special.append(SpecialPoint("grazing", len(pts_v) - 1, 0.5 * (unpack(v)[2] + mu_new),
                                         tuple(sorted((unpack(v)[2], mu_new))), abs(mu_new - unpack(v)[2]),
                                         {"events_before": len(fl.modes) - 1, "events_after": len(fl_new.modes) - 1}))
         v, t, fl = v_new, t_new, fl_new
