@@ -11,6 +11,12 @@ def _plt():
     return plt
 
 
+def save(fig, path) -> None:
+    """Save a figure and release it (reproducers make dozens of figures)."""
+    fig.savefig(path, dpi=130)
+    _plt().close(fig)
+
+
 def plot_trajectory(traj, *, title: str = "", stick_modes=(), units: dict | None = None, path=None):
     """Time responses of every state and a phase portrait (x1, x2, x3 in 3-D).
 
@@ -52,7 +58,7 @@ def plot_trajectory(traj, *, title: str = "", stick_modes=(), units: dict | None
         fig.suptitle(title)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=120)
+        save(fig, path)
     return fig
 
 
@@ -70,7 +76,7 @@ def plot_hysteresis(force, displacement, *, title: str = "", path=None, units=("
         ax.set_title(title)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=120)
+        save(fig, path)
     return fig
 
 
@@ -117,7 +123,7 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
     if own:
         fig.tight_layout()
         if path is not None:
-            fig.savefig(path, dpi=130)
+            save(fig, path)
     return fig
 
 
@@ -168,7 +174,7 @@ def plot_map_diagram(diagram, *, title: str = "", ax=None, path=None, unit: str 
     if own:
         fig.tight_layout()
         if path is not None:
-            fig.savefig(path, dpi=130)
+            save(fig, path)
     return fig
 
 
@@ -234,7 +240,7 @@ def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "r
         ax.set_title(title, fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=130)
+        save(fig, path)
     return fig
 
 
@@ -258,5 +264,5 @@ def plot_cycles(system, orbits, labels, *, title: str = "", path=None, eq_bounds
         ax.set_title(title, fontsize=10)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=130)
+        save(fig, path)
     return fig

@@ -14,7 +14,7 @@ from ..continuation import find_cycle, follow, shoot
 from ..continuation.shooting import guess_from_stick_error
 from ..eventmap import fixed_points
 from ..models import preset
-from ..plotting import _plt, plot_branch, plot_cycles, plot_trajectory
+from ..plotting import _plt, save, plot_branch, plot_cycles, plot_trajectory
 from .checks import Ledger
 
 TABLE_8_1 = dict(m=0.026, cm=16.0, Fs=0.53, Fc=0.44, vs=0.02, b=0.1, sigma0=2.2e4, sigma1=7.58, eta=1e-6, alpha=10.0)
@@ -156,7 +156,7 @@ def run(out: Path) -> int:
                 "(circles: unstable cycles from the event map)",
                 equilibrium_stable=(np.array([0.0321, 1.0]), np.array([True, True])))
     ax.plot([r["K"] for r in rows], [r["d"] for r in rows], "o", mfc="w", mec="k", ms=6)
-    fig.savefig(out / "fig8_5.png", dpi=130)
+    save(fig, out / "fig8_5.png")
 
     L.save(out / "ch8.json", extra=dict(results=results, seconds=time.perf_counter() - t_start))
     return L.finish(out)

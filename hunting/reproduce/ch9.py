@@ -12,7 +12,7 @@ from .. import simulate
 from ..eventmap import event_map, fixed_points, map_diagram
 from ..models import preset
 from ..models import servo as S
-from ..plotting import _plt, plot_event_map, plot_map_diagram, plot_trajectory
+from ..plotting import _plt, save, plot_event_map, plot_map_diagram, plot_trajectory
 from .checks import Ledger
 
 CURVES = {"beta=2": dict(beta=2.0), "beta=1": dict(beta=1.0), "beta=0.5": dict(beta=0.5),
@@ -66,7 +66,7 @@ def run(out: Path) -> int:
     zoom = event_map(loop, np.linspace(0.0, 0.008, 161), 2, derivative=False)
     plot_event_map(zoom, fixed=[f for f in fps if f.d < 0.008], title="near the equilibrium set", ax=axes[1])
     fig.tight_layout()
-    fig.savefig(out / "fig9_6.png", dpi=130)
+    save(fig, out / "fig9_6.png")
 
     print("Table 9.3 / Fig. 9.7 -- other damping curves")
     thesis93 = {"beta=1": 0.2314, "beta=0.5": 0.1786, "discontinuous": 0.1485}
@@ -86,7 +86,7 @@ def run(out: Path) -> int:
         print(f"    origin: {e3.origin.behaviour}, P^2(delta)/delta = {e3.slope:.3g} at delta = {e3.origin.probes[0][-1]:.1e}")
         plot_event_map(em, fixed=f3, title=f"Fig. 9.7: P$^2$, {name}", ax=ax)
     fig.tight_layout()
-    fig.savefig(out / "fig9_7.png", dpi=130)
+    save(fig, out / "fig9_7.png")
 
     print("Fig. 9.8 -- bifurcation diagrams, P = 10 ... 31")
     Ps = np.arange(10, 32, dtype=float)
@@ -98,7 +98,7 @@ def run(out: Path) -> int:
         results[f"fig9.8 {name}"] = dg.as_dict()
         plot_map_diagram(dg, title=f"Fig. 9.8: {name}", ax=ax)
     fig.tight_layout()
-    fig.savefig(out / "fig9_8.png", dpi=130)
+    save(fig, out / "fig9_8.png")
     d2 = diagrams["beta=2"]
     L.fact("beta=2: equilibrium set stable for all P", bool(d2.equilibrium_stable().all()), True)
     last = int(Ps[np.flatnonzero(d2.n_cycles() > 0)[-1]])
@@ -154,7 +154,7 @@ def run(out: Path) -> int:
     axes[-1].set_xlabel("t [s]")
     fig.suptitle("Fig. 11.1: Coulomb friction only, decreasing viscous damping")
     fig.tight_layout()
-    fig.savefig(out / "fig11_1.png", dpi=130)
+    save(fig, out / "fig11_1.png")
     lin = A.coulomb_map_slope(preset("table9.1", Fc=4.0))
     hom = preset("table9.1", Fc=4.0)
     from ..eventmap import evaluate_map
@@ -179,7 +179,7 @@ def run(out: Path) -> int:
         ax.grid(alpha=0.3)
     fig.suptitle("Fig. 11.3: Stribeck-related block F_nl = g sgn - Fs sgn + (b - b*) v")
     fig.tight_layout()
-    fig.savefig(out / "fig11_3.png", dpi=130)
+    save(fig, out / "fig11_3.png")
     small = results["fig11.3"]["beta=2"]
     L.fact("beta=2: F_nl passive for small |v| (first non-passive |v| > 0)", bool(small and min(abs(small[-1][0]), abs(small[0][1])) > 0.005), True)
 
