@@ -17,6 +17,16 @@ def save(fig, path) -> None:
     _plt().close(fig)
 
 
+def _finish(fig, ax, own: bool, title: str, path) -> None:
+    """Common tail of the single-axes plots: title, layout and saving when the figure is ours."""
+    if title:
+        ax.set_title(title, fontsize=10)
+    if own:
+        fig.tight_layout()
+        if path is not None:
+            save(fig, path)
+
+
 def plot_trajectory(traj, *, title: str = "", stick_modes=(), units: dict | None = None, path=None):
     """Time responses of every state and a phase portrait (x1, x2, x3 in 3-D).
 
@@ -118,12 +128,7 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
     ax.set_ylabel(f"d$^{{n+{k}}}$ [{unit}]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")
-    if title:
-        ax.set_title(title, fontsize=10)
-    if own:
-        fig.tight_layout()
-        if path is not None:
-            save(fig, path)
+    _finish(fig, ax, own, title, path)
     return fig
 
 
@@ -169,12 +174,7 @@ def plot_map_diagram(diagram, *, title: str = "", ax=None, path=None, unit: str 
     ax.set_ylabel(f"stick error d* [{unit}]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
-    if title:
-        ax.set_title(title, fontsize=10)
-    if own:
-        fig.tight_layout()
-        if path is not None:
-            save(fig, path)
+    _finish(fig, ax, own, title, path)
     return fig
 
 

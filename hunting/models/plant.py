@@ -15,6 +15,20 @@ FEXT_NONE, FEXT_CONSTANT, FEXT_TRIANGLE = 0, 1, 2
 
 
 @numba.njit(cache=True, error_model="numpy", inline='always')
+def _segment(q, p, d, n):
+    """Index lo of the table segment [q_lo, q_lo+1] holding q (bisection; q inside the table)."""
+    lo = 0
+    hi = n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if p[d + mid] <= q:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@numba.njit(cache=True, error_model="numpy", inline='always')
 def cogging_force(q, p, base):
     """Cogging force F_cog(q) [N] from the flat parameter array, block starting at ``base``:
     [kind, n, L, data...]; harmonic: F = sum_k a_k cos(2 pi k q / L) + b_k sin(2 pi k q / L),
@@ -36,18 +50,11 @@ def cogging_force(q, p, base):
         return p[d + n]
     if q >= p[d + n - 1]:
         return p[d + 2 * n - 1]
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if p[d + mid] <= q:
-            lo = mid
-        else:
-            hi = mid
+    lo = _segment(q, p, d, n)
     q0 = p[d + lo]
-    q1 = p[d + hi]
+    q1 = p[d + lo + 1]
     w1 = (q - q0) / (q1 - q0)
-    return (1.0 - w1) * p[d + n + lo] + w1 * p[d + n + hi]
+    return (1.0 - w1) * p[d + n + lo] + w1 * p[d + n + lo + 1]
 
 
 @numba.njit(cache=True, error_model="numpy", inline='always')
@@ -67,15 +74,8 @@ def cogging_slope(q, p, base):
         return acc
     if q <= p[d] or q >= p[d + n - 1]:
         return 0.0
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if p[d + mid] <= q:
-            lo = mid
-        else:
-            hi = mid
-    return (p[d + n + hi] - p[d + n + lo]) / (p[d + hi] - p[d + lo])
+    lo = _segment(q, p, d, n)
+    return (p[d + n + lo + 1] - p[d + n + lo]) / (p[d + lo + 1] - p[d + lo])
 
 
 @numba.njit(cache=True, error_model="numpy", inline='always')
