@@ -39,7 +39,17 @@ def batch_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     the end, time of the first event, total time spent in ``stop_mode`` before the end."""
     m = X0.shape[0]
     n = X0.shape[1]
+    n_modes = directions.shape[0]
+    ng = directions.shape[1]
+    nf = 40 * n + 11 * n * n + 11 * n + 4 * n * n + 3 * ng + 50 + n_modes    # K.workspace_sizes
+    ni = 4 * n + ng
     for k in numba.prange(m):
+        wf = np.empty(nf)
+        wi = np.empty(ni, dtype=np.int64)
+        # per-run copies of the shared arrays: reference counting on one array from several
+        # threads makes its cache line bounce between cores
+        p_k = p.copy()
+        dir_k = directions.copy()
         out_t = np.empty(1)
         out_x = np.empty((1, n))
         out_m = np.empty(1, dtype=np.int64)
@@ -55,10 +65,10 @@ def batch_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
         xf = np.empty(n)
         te = np.empty(0)
         K.integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, n, 0.0, t_max,
-                           np.ascontiguousarray(X0[k]), mode0[k], p, directions, rtol, atol[k], 0.0,
+                           np.ascontiguousarray(X0[k]), mode0[k], p_k, dir_k, rtol, atol[k], 0.0,
                            np.inf, max_steps, max_events, guard_tol[k], False, te, False, stop_mode,
                            stop_count, 50, 1e-10, out_t, out_x, out_m,
-                           ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo, xf)
+                           ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo, xf, wf, wi)
         st = info[K.I_STATUS]
         if st == K._S_FULL:
             st = K._S_MAXEVENTS

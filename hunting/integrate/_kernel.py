@@ -48,6 +48,19 @@ _S_FULL = int(Status.BUFFER_FULL)
 _S_INVALID = int(Status.INVALID_MODE)
 
 
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def _put_row(dst, row, src):
+    """dst[row, :] = src without the temporaries of slice assignment (the kernel runs without NRT)."""
+    for i in range(src.size):
+        dst[row, i] = src[i]
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def _put(dst, src):
+    for i in range(src.size):
+        dst[i] = src[i]
+
+
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _guards_base(guards, mode, t, y, p, out, xb):
     """Guards of the base state y[:nb] (y may carry sensitivities after it)."""
@@ -264,17 +277,24 @@ KERNEL_SIG = types.void(
     types.float64[::1], types.float64[:, ::1], types.float64[:, ::1], types.int64[::1],
     types.int64[::1], types.int64[::1],
     types.int64[::1], types.float64[::1], types.float64[::1],
+    types.float64[::1], types.int64[::1],
 )
 
 
-@numba.njit(KERNEL_SIG, cache=True, error_model="numpy")
+def workspace_sizes(n: int, nb: int, ng: int, n_modes: int, zeno_count: int) -> tuple[int, int]:
+    """Sizes of the float and int workspaces integrate_kernel needs."""
+    nf = 40 * n + 11 * n * n + 11 * nb + 4 * nb * nb + 3 * ng + max(zeno_count, 1) + n_modes
+    return nf, 4 * n + ng
+
+
+@numba.njit(KERNEL_SIG, cache=True, error_model="numpy", _nrt=False)
 def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                      t0, t1, x0, mode0, p, directions,
                      rtol, atol, h0, hmax, max_steps, max_events, guard_tol, fixed,
                      t_eval, record_steps, stop_mode, stop_count, zeno_count, zeno_window,
                      out_t, out_x, out_mode,
                      ev_t, ev_xb, ev_xa, ev_guard, ev_from, ev_to,
-                     info, finfo, x_final):
+                     info, finfo, x_final, wf, wi):
     """Integrate from (t0, x0, mode0) towards t1; see the module docstring.
 
     Inputs: ``mode0 < 0`` asks ``mode_of``; ``h0 <= 0`` selects the first step; ``fixed``
@@ -291,7 +311,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
 
     Outputs: info (status, counts, final mode), finfo (final t, last step), x_final, and the
     buffers out_* (points, all n columns) and ev_* (event time, base state before/after, guard,
-    modes)."""
+    modes). wf, wi: float and int workspaces of at least workspace_sizes(...) entries."""
     n = x0.size
     n_modes = directions.shape[0]
     ng = directions.shape[1]
@@ -300,11 +320,99 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
     n_eval = t_eval.size
     use_eval = n_eval > 0
 
-    x = x0.copy()
+    # every work array is carved out of the caller's workspace (see workspace_sizes): the kernel
+    # allocates nothing, runs without reference counting (_nrt=False) and its helpers inline
+    o = 0
+    x = wf[o:o + n]
+    o += n
+    xb = wf[o:o + nb]
+    o += nb
+    xb2 = wf[o:o + nb]
+    o += nb
+    f = wf[o:o + n]
+    o += n
+    y_new = wf[o:o + n]
+    o += n
+    f_new = wf[o:o + n]
+    o += n
+    ytmp = wf[o:o + n]
+    o += n
+    ftmp = wf[o:o + n]
+    o += n
+    err = wf[o:o + n]
+    o += n
+    xs = wf[o:o + n]
+    o += n
+    K = wf[o:o + 16 * n].reshape((16, n))
+    o += 16 * n
+    Q = wf[o:o + 7 * n].reshape((7, n))
+    o += 7 * n
+    J = wf[o:o + n * n].reshape((n, n))
+    o += n * n
+    M = wf[o:o + 9 * n * n].reshape((3 * n, 3 * n))
+    o += 9 * n * n
+    Mr = wf[o:o + n * n].reshape((n, n))
+    o += n * n
+    Z = wf[o:o + 3 * n].reshape((3, n))
+    o += 3 * n
+    F3 = wf[o:o + 3 * n].reshape((3, n))
+    o += 3 * n
+    R = wf[o:o + 3 * n]
+    o += 3 * n
+    g_old = wf[o:o + ng]
+    o += ng
+    g_new = wf[o:o + ng]
+    o += ng
+    gs = wf[o:o + ng]
+    o += ng
+    nz = max(zeno_count, 1)
+    zeno_times = wf[o:o + nz]
+    o += nz
+    # last error-controlled step size per mode: re-entering a mode starts from it instead of
+    # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
+    h_mode = wf[o:o + n_modes]
+    o += n_modes
+    yw = wf[o:o + nb]
+    o += nb
+    fw = wf[o:o + nb]
+    o += nb
+    fp = wf[o:o + nb]
+    o += nb
+    fm = wf[o:o + nb]
+    o += nb
+    fbm = wf[o:o + nb]
+    o += nb
+    fbp = wf[o:o + nb]
+    o += nb
+    gradh = wf[o:o + nb]
+    o += nb
+    xw = wf[o:o + nb]
+    o += nb
+    xw2 = wf[o:o + nb]
+    o += nb
+    Jw = wf[o:o + nb * nb].reshape((nb, nb))
+    o += nb * nb
+    Jb = wf[o:o + nb * nb].reshape((nb, nb))
+    o += nb * nb
+    Ssal = wf[o:o + nb * nb].reshape((nb, nb))
+    o += nb * nb
+    Rx = wf[o:o + nb * nb].reshape((nb, nb))
+    piv = wi[0:3 * n]
+    pivr = wi[3 * n:4 * n]
+    armed = wi[4 * n:4 * n + ng]
+    for i in range(nz):
+        zeno_times[i] = -np.inf
+    for i in range(n_modes):
+        h_mode[i] = np.inf
+    for i in range(7):
+        for j in range(n):
+            Q[i, j] = 0.0
+    sens = nb < n
+
+    for i in range(n):
+        x[i] = x0[i]
     t = t0
     mode = mode0
-    xb = np.empty(nb)
-    xb2 = np.empty(nb)
     for i in range(nb):
         xb[i] = x[i]
     if mode < 0:
@@ -313,44 +421,9 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
         info[I_STATUS] = _S_INVALID
         info[I_MODE] = mode
         finfo[F_T] = t
-        x_final[:] = x
+        _put(x_final, x)
         return
 
-    f = np.empty(n)
-    y_new = np.empty(n)
-    f_new = np.empty(n)
-    ytmp = np.empty(n)
-    ftmp = np.empty(n)
-    err = np.empty(n)
-    xs = np.empty(n)
-    K = np.empty((16, n))
-    Q = np.zeros((7, n))
-    J = np.empty((n, n))
-    M = np.empty((3 * n, 3 * n))
-    piv = np.empty(3 * n, dtype=np.int64)
-    Mr = np.empty((n, n))
-    pivr = np.empty(n, dtype=np.int64)
-    Z = np.empty((3, n))
-    F3 = np.empty((3, n))
-    R = np.empty(3 * n)
-    g_old = np.empty(ng)
-    g_new = np.empty(ng)
-    gs = np.empty(ng)
-    armed = np.zeros(ng, dtype=np.bool_)
-    zeno_times = np.full(max(zeno_count, 1), -np.inf)
-    # last error-controlled step size per mode: re-entering a mode starts from it instead of
-    # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
-    h_mode = np.full(n_modes, np.inf)
-    sens = nb < n
-    yw, fw, fp, fm, Jw = np.empty(nb), np.empty(nb), np.empty(nb), np.empty(nb), np.empty((nb, nb))
-    Jb = np.empty((nb, nb))
-    fbm = np.empty(nb)
-    fbp = np.empty(nb)
-    gradh = np.empty(nb)
-    Ssal = np.empty((nb, nb))
-    Rx = np.empty((nb, nb))
-    xw = np.empty(nb)
-    xw2 = np.empty(nb)
     n_threshold = 0   # consecutive events of guards that never left their tolerance band
 
     n_out = info[I_NOUT]
@@ -373,13 +446,13 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
 
     if record_steps and not use_eval and n_out == 0:
         out_t[0] = t
-        out_x[0, :] = x
+        _put_row(out_x, 0, x)
         out_mode[0] = mode
         n_out = 1
     while use_eval and i_eval < n_eval and t_eval[i_eval] <= t:
         if t_eval[i_eval] == t:
             out_t[n_out] = t
-            out_x[n_out, :] = x
+            _put_row(out_x, n_out, x)
             out_mode[n_out] = mode
             n_out += 1
         i_eval += 1
@@ -429,7 +502,9 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                 for i in range(nb):
                     xw[i] = x[i]
                 nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, Jb, fbm, fbp, nb)
-                J[:, :] = 0.0
+                for i in range(n):
+                    for j in range(n):
+                        J[i, j] = 0.0
                 for i in range(nb):
                     for k in range(nb):
                         J[i, k] = Jb[i, k]
@@ -511,7 +586,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
             while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_ev:
                 dense_eval(method, t, h, x, Q, t_eval[i_eval], xs)
                 out_t[n_out] = t_eval[i_eval]
-                out_x[n_out, :] = xs
+                _put_row(out_x, n_out, xs)
                 out_mode[n_out] = mode
                 n_out += 1
                 i_eval += 1
@@ -542,8 +617,8 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                 for i in range(nb, n):
                     ytmp[i] = xs[i]
             ev_t[n_ev] = t_ev
-            ev_xb[n_ev, :] = xb
-            ev_xa[n_ev, :] = xb2
+            _put_row(ev_xb, n_ev, xb)
+            _put_row(ev_xa, n_ev, xb2)
             ev_guard[n_ev] = i_ev
             ev_from[n_ev] = mode
             ev_to[n_ev] = new_mode
@@ -551,7 +626,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
             n_ev_total += 1
             if record_steps and not use_eval:
                 out_t[n_out] = t_ev
-                out_x[n_out, :] = xs
+                _put_row(out_x, n_out, xs)
                 out_mode[n_out] = mode
                 n_out += 1
             t = t_ev
@@ -567,7 +642,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
             mode = new_mode
             if record_steps and not use_eval:
                 out_t[n_out] = t
-                out_x[n_out, :] = x
+                _put_row(out_x, n_out, x)
                 out_mode[n_out] = mode
                 n_out += 1
             # Zeno: zeno_count events within zeno_window, or zeno_count consecutive events of
@@ -603,7 +678,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
         while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new:
             dense_eval(method, t, h, x, Q, t_eval[i_eval], xs)
             out_t[n_out] = t_eval[i_eval]
-            out_x[n_out, :] = xs
+            _put_row(out_x, n_out, xs)
             out_mode[n_out] = mode
             n_out += 1
             i_eval += 1
@@ -615,7 +690,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
             g_old[i] = g_new[i]
         if record_steps and not use_eval:
             out_t[n_out] = t
-            out_x[n_out, :] = x
+            _put_row(out_x, n_out, x)
             out_mode[n_out] = mode
             n_out += 1
         if last:
@@ -643,4 +718,4 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
     info[I_NEVTOT] = n_ev_total
     finfo[F_T] = t
     finfo[F_H] = h
-    x_final[:] = x
+    _put(x_final, x)

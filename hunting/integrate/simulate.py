@@ -123,6 +123,8 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     finfo = np.zeros(K.N_FINFO)
     x_final = np.empty(n)
     jac = system.jacobian if system.jacobian is not None else no_jacobian
+    nf, ni = K.workspace_sizes(n, n, system.n_guards, system.n_modes, int(zeno_count))
+    wf, wi = np.empty(nf), np.empty(ni, dtype=np.int64)
     t_cur, x_cur, m_cur = t0, x0, m0
     for _ in range(10_000):
         steps_left = int(max_steps) - int(info[K.I_NSTEPS] + info[K.I_NREJ])
@@ -131,7 +133,7 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
                            system.directions, rtol, atol, h0, hmax, steps_left, int(max_events),
                            guard_tol, fixed, te, True, sm, int(stop_count), int(zeno_count), zw,
                            out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to,
-                           info, finfo, x_final)
+                           info, finfo, x_final, wf, wi)
         if info[K.I_STATUS] != Status.BUFFER_FULL:
             break
         # grow whichever buffer is full and resume from the step boundary
