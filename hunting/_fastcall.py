@@ -23,13 +23,16 @@ def _memo(cache, orig):
     def lookup(func, sig):
         if not isinstance(func, Dispatcher):
             return orig(func, sig)
-        key = (id(func), sig)
+        # the protocol's functions have exactly one overload: key on the dispatcher alone
+        # (hashing numba signatures costs more than the lookup it saves)
+        single = len(func.overloads) == 1
+        key = id(func) if single else (id(func), sig)
         hit = cache.get(key)
-        if hit is not None and hit[0] is func:
+        if hit is not None and hit[0] is func and hit[2] == len(func.overloads):
             return hit[1]
         addr = orig(func, sig)
         if addr > 0:
-            cache[key] = (func, addr)
+            cache[key] = (func, addr, len(func.overloads))
         return addr
     lookup.__wrapped__ = orig
     return lookup

@@ -61,7 +61,7 @@ def _put(dst, src):
         dst[i] = src[i]
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def _guards_base(guards, mode, t, y, p, out, xb):
     """Guards of the base state y[:nb] (y may carry sensitivities after it)."""
     for i in range(xb.size):
@@ -69,7 +69,7 @@ def _guards_base(guards, mode, t, y, p, out, xb):
     guards(mode, t, xb, p, out)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, xb, gs):
     dense_eval(method, t_old, h, y_old, Q, t, xs)
     _guards_base(guards, mode, t, xs, p, gs, xb)

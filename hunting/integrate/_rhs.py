@@ -12,7 +12,7 @@ import numpy as np
 EPS = np.finfo(np.float64).eps
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, p, out):
     """out = f(y) (plain) or [f(x), J(x) Phi] (augmented). Returns extra f evaluations."""
     if nb == y.size:

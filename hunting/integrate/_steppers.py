@@ -18,7 +18,7 @@ EPS = np.finfo(np.float64).eps
 NEWTON_MAXITER = 6
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def _rms_scaled(err, y, y_new, rtol, atol):
     n = err.size
     s = 0.0
@@ -62,7 +62,7 @@ def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f,
     return min(100 * h0, h1, direction_span)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
                   f_new, err):
     """One explicit Runge-Kutta step (DP5 or DOP853, FSAL). Returns the scaled error norm.
@@ -166,7 +166,7 @@ def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y,
     return D853_NSE - D853_NS - 1
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def dense_eval(method, t_old, h, y_old, Q, t, out):
     """State at time t in [t_old, t_old + h] from the step's dense output."""
     n = y_old.size
