@@ -41,8 +41,7 @@ def batch_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
     n = X0.shape[1]
     n_modes = directions.shape[0]
     ng = directions.shape[1]
-    nf = 40 * n + 11 * n * n + 11 * n + 4 * n * n + 3 * ng + 50 + n_modes    # K.workspace_sizes
-    ni = 4 * n + ng
+    nf, ni = K.workspace_sizes(n, n, ng, n_modes, 50)
     for k in numba.prange(m):
         wf = np.empty(nf)
         wi = np.empty(ni, dtype=np.int64)

@@ -281,8 +281,9 @@ KERNEL_SIG = types.void(
 )
 
 
-def workspace_sizes(n: int, nb: int, ng: int, n_modes: int, zeno_count: int) -> tuple[int, int]:
-    """Sizes of the float and int workspaces integrate_kernel needs."""
+@numba.njit(cache=True)
+def workspace_sizes(n, nb, ng, n_modes, zeno_count):
+    """Sizes (float, int) of the workspaces integrate_kernel needs (callable from Python and numba)."""
     nf = 40 * n + 11 * n * n + 11 * nb + 4 * nb * nb + 3 * ng + max(zeno_count, 1) + n_modes
     return nf, 4 * n + ng
 
