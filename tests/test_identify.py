@@ -1,0 +1,64 @@
+"""FRF estimation and low-order fits on linear systems with known transfer functions."""
+import numpy as np
+import pytest
+from scipy import signal
+
+from hunting import SystemDefinitionError
+from hunting.identify import (controller_frf, estimate_frf, fit_double_integrator, fit_second_order,
+                              plant_from_sensitivity)
+from hunting.identify.frf import prbs
+from hunting.models import PID
+
+FS = 10_000.0
+
+
+def _simulate(num, den, u):
+    sysd = signal.cont2discrete((num, den), 1 / FS, method="bilinear")
+    return signal.lfilter(sysd[0].ravel(), sysd[1], u)
+
+
+def test_frf_of_a_second_order_system_and_sk_fit():
+    """Presliding-like model cm / (J s^2 + c s + k): the FRF and the fitted parameters."""
+    J, c, k, cm = 0.018, 4.47, 1.21e4, 16.0
+    u = prbs(2 ** 17, bandwidth=500.0, fs=FS, seed=1)
+    y = _simulate([cm], [J, c, k], u)
+    frf = estimate_frf(u, y, FS)
+    w = 2 * np.pi * frf.f
+    true = cm / (J * (1j * w) ** 2 + c * (1j * w) + k)
+    band = (frf.f > 5) & (frf.f < 300)
+    # bilinear discretization warps frequencies by tan(w/2fs) (<0.3 % below 300 Hz)
+    assert np.max(np.abs(frf.H[band] / true[band] - 1)) < 0.02
+    assert np.all(frf.coherence[band] > 0.99)
+    fit = fit_second_order(frf, 5.0, 300.0)
+    assert fit["a0"] == pytest.approx(k / J, rel=0.01)           # sigma0 / J
+    assert fit["a1"] == pytest.approx(c / J, rel=0.03)           # (sigma1 + sigma2) / J
+    assert fit["b0"] == pytest.approx(cm / J, rel=0.01)
+    assert fit.residual < 0.02 and all(v > 0 for v in fit.sigma.values())
+
+
+def test_closed_loop_sensitivity_gives_the_double_integrator():
+    """Weak PD loop around a mass, excitation v at the controller output (thesis Fig. 10.3):
+    S = W/V and P = (1/S - 1)/C recover cm/m."""
+    m, cm = 8.93, 74.4
+    pd = PID(kp=50.0, kd=2.0, ki=0.0)
+    # closed loop from v to w = u + v: S = 1 / (1 + P C), P = cm / (m s^2)
+    num_s = [m, 0.0, 0.0]
+    den_s = [m, cm * pd.kd, cm * pd.kp]
+    v = prbs(2 ** 17, bandwidth=500.0, fs=FS, amplitude=0.1, seed=2)
+    w = _simulate(num_s, den_s, v)
+    S = estimate_frf(v, w, FS)
+    P = plant_from_sensitivity(S, pd)
+    fit = fit_double_integrator(P, 2.0, 100.0)
+    assert fit["g"] == pytest.approx(cm / m, rel=0.01)
+    assert fit.sigma["g"] < 0.01 * fit["g"]
+    Cv = controller_frf(pd, np.array([10.0]))
+    assert Cv[0] == pytest.approx(50.0 + 2.0 * 2j * np.pi * 10.0)
+
+
+def test_errors_are_named():
+    with pytest.raises(SystemDefinitionError, match="must match"):
+        estimate_frf(np.zeros(10), np.zeros(11), FS)
+    with pytest.raises(SystemDefinitionError, match="fewer than nperseg"):
+        estimate_frf(np.zeros(100), np.zeros(100), FS)
+    with pytest.raises(SystemDefinitionError, match="fs = -1 is not allowed"):
+        estimate_frf(np.zeros(100), np.zeros(100), -1)
