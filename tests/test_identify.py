@@ -62,3 +62,38 @@ def test_errors_are_named():
         estimate_frf(np.zeros(100), np.zeros(100), FS)
     with pytest.raises(SystemDefinitionError, match="fs = -1 is not allowed"):
         estimate_frf(np.zeros(100), np.zeros(100), -1)
+
+
+def test_stribeck_fit_recovers_table_10_2_per_direction():
+    from hunting.identify import fit_stribeck
+    from hunting.models import StribeckCurve
+    rng = np.random.default_rng(3)
+    pos = StribeckCurve(13.35, 28.3, 0.019, 2.0, 36.45)
+    neg = StribeckCurve(13.45, 27.5, 0.020, 2.0, 37.95)
+    vp = np.geomspace(0.002, 0.4, 40)
+    v = np.concatenate([vp, -vp])
+    F = np.concatenate([pos.force(vp), -neg.force(vp)]) + rng.normal(0, 0.1, 2 * vp.size)
+    fits = fit_stribeck(v, F, direction_dependent=True)
+    for key, true in (("positive", pos), ("negative", neg)):
+        f = fits[key]
+        for name, t, tol in (("Fc", true.Fc, 0.02), ("Fs", true.Fs, 0.02), ("vs", true.vs, 0.05), ("b", true.b, 0.03)):
+            assert f[name] == pytest.approx(t, rel=tol), (key, name)
+            assert abs(f[name] - t) < 5 * f.sigma[name] + 1e-12    # uncertainty is honest
+        assert f.residual == pytest.approx(0.1, rel=0.3)
+    with pytest.raises(SystemDefinitionError, match="v = 0 is not allowed"):
+        fit_stribeck([0.0, 0.1, 0.2, 0.3, 0.4], [0, 1, 1, 1, 1])
+
+
+def test_cogging_table_from_a_slow_two_direction_run():
+    from hunting.identify import cogging_table
+    rng = np.random.default_rng(4)
+    q = np.linspace(-0.45, -0.05, 8001)
+    cog = lambda x: 5.0 * np.sin(2 * np.pi * x / 0.015) + 2.0 * np.sin(2 * np.pi * x / 0.0075 + 0.4)  # noqa: E731
+    Fp = cog(q) + 14.0 + rng.normal(0, 0.5, q.size)       # moving +: friction offset +14 N
+    Fn = cog(q) - 13.5 + rng.normal(0, 0.5, q.size)       # moving -: -13.5 N
+    tab = cogging_table(np.concatenate([q, q[::-1]]), np.concatenate([Fp, Fn[::-1]]),
+                        np.concatenate([np.full(q.size, 0.05), np.full(q.size, -0.05)]))
+    qq = np.linspace(-0.44, -0.06, 500)
+    err = tab(qq) - cog(qq)
+    err -= err.mean()                                      # a constant shift is the friction mean
+    assert np.sqrt(np.mean(err ** 2)) < 0.05 * 5.0         # small against the amplitude
