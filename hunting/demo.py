@@ -62,8 +62,8 @@ def run_demo(out: Path) -> int:
     t_eval = np.linspace(0.0, period, 2001)
     tr = simulate(lp.system, lp.state(), (0.0, period), method="radau", rtol=1e-9, atol=1e-13,
                   t_eval=t_eval, throw=True)
-    from .models.plant import external_force
-    force = np.array([external_force(t, 2, lp.plant.external_force[1], period) for t in tr.t])
+    from .models.plant import FEXT_TRIANGLE, external_force
+    force = np.array([external_force(t, FEXT_TRIANGLE, lp.plant.external_force[1], period) for t in tr.t])
     xmax = float(np.max(np.abs(tr.x[:, 0])))
     _check(rows, "displacement after one force cycle / max", float(abs(tr.x[-1, 0]) / xmax), 0.0, 1e-3)
     plot_hysteresis(force, tr.x[:, 0], title="Fig. 4.2: LuGre presliding (Table 4.1)", path=out / "fig4_2.png")

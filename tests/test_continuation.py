@@ -4,7 +4,6 @@ import math
 import numpy as np
 import pytest
 
-import hunting
 from hunting.continuation import ContinuationOptions, continue_orbit, cycle_guess, fd_jacobian, flow, shoot
 from hunting.continuation.shooting import guess_from_stick_error
 from hunting.eventmap import fixed_points

@@ -8,7 +8,6 @@ import hunting
 from hunting import SystemDefinitionError
 from hunting.models import (PID, Cogging, Coulomb, DirectionalCurve, Discontinuous, LuGre, Plant,
                             StribeckCurve, Switch, Viscous, preset)
-from hunting.models import servo as S
 
 
 @pytest.mark.parametrize("beta", [0.5, 1.0, 2.0, 3.7])

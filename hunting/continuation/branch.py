@@ -12,7 +12,7 @@ bracketed between two branch points with the event counts before and after.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -21,7 +21,7 @@ from ..errors import Status, SystemDefinitionError
 from ..results import SpecialPoint
 from ..system import PiecewiseSystem
 from .flow import flow
-from .shooting import PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude, shoot
+from .shooting import PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude
 
 
 @dataclass(frozen=True)
@@ -308,6 +308,3 @@ def _refine_fold(correct, tangent, unpack, v0, t0, ds, opt, index):
     lo_mu, hi_mu = min(mus + [mu]), max(mus + [mu])
     x, T, _ = unpack(v)
     return SpecialPoint("fold", index, float(mu), (lo_mu, hi_mu), hi_mu - lo_mu, {"period": float(T)})
-
-
-_ = shoot

@@ -7,7 +7,6 @@ import numpy as np
 
 from ..models.loop import ServoLoop
 from .engine import MapOptions, evaluate_map
-from .fixedpoints import FixedPoint
 
 
 @dataclass(frozen=True)
@@ -55,6 +54,3 @@ def basins(loop: ServoLoop, grid, fixed: list, iterate: int = 2, *, max_iter: in
             intervals.append((float(grid[start]), float(grid[i - 1]), int(fate[start])))
             start = i
     return Basins(grid, fate, stable, intervals)
-
-
-_ = FixedPoint

@@ -11,7 +11,7 @@ from ..errors import SystemDefinitionError
 from ..models.presets import preset
 from ..results import SpecialPoint
 from .engine import MapOptions, evaluate_map
-from .fixedpoints import FixedPoint, fixed_points, origin_slope
+from .fixedpoints import fixed_points, origin_slope
 
 
 def default_grid(d_max: float, n: int = 201, n_small: int = 40) -> np.ndarray:
@@ -155,6 +155,3 @@ def map_diagram(preset_name: str, param: str, values, *, overrides: dict | None 
                                         {"stable_above": float(eb.stable)}))
     label = f"{preset_name} " + " ".join(f"{k}={v}" for k, v in overrides.items())
     return MapDiagram(param, values, fixed, special, iterate, label.strip())
-
-
-_ = FixedPoint

@@ -169,7 +169,6 @@ def event_map(loop: ServoLoop, grid, iterate: int = 1, *, derivative: bool = Tru
     method = "none"
     if derivative:
         h = opt.fd_step * np.maximum(np.abs(grid), opt.d_floor)
-        # at d = 0 use one-sided slopes' mean only when both sides exist; P(0) = 0
         plus = evaluate_map(loop, grid + h, iterate, opt)
         minus = evaluate_map(loop, grid - h, iterate, opt)
         deriv = (plus.image - minus.image) / (2 * h)

@@ -9,7 +9,6 @@ import numba
 import numpy as np
 from numba import types
 
-from ..errors import Status
 from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE
 from . import _kernel as K
 
@@ -112,6 +111,3 @@ def run_batch(system, X0, mode0, *, t_max: float, atol, rtol: float = 1e-12, met
                  guard_tol, int(stop_mode), int(stop_count), X_end, mode_end, status, n_events,
                  fout)
     return X_end, mode_end, status, n_events, fout
-
-
-_ = Status  # status codes in ``status`` are hunting.Status values

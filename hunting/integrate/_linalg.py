@@ -4,7 +4,6 @@ numba's np.linalg.solve refactors on every call; the Newton iteration of Radau I
 factorization for several solves, so the factorization is kept here (n <= a few tens).
 """
 import numba
-import numpy as np
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)

@@ -3,7 +3,7 @@ position-dependent force (cogging, thesis chapter 10) and a known external force
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numba
 import numpy as np

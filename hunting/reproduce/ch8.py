@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import analysis as A
 from .. import simulate
-from ..continuation import find_cycle, follow, shoot
+from ..continuation import follow, shoot
 from ..continuation.shooting import guess_from_stick_error
 from ..eventmap import fixed_points
 from ..models import preset
@@ -160,6 +160,3 @@ def run(out: Path) -> int:
 
     L.save(out / "ch8.json", extra=dict(results=results, seconds=time.perf_counter() - t_start))
     return L.finish(out)
-
-
-_ = (find_cycle, _plt)
