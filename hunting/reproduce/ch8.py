@@ -121,9 +121,10 @@ def run(out: Path) -> int:
             stable=dict(period=po_s.period, amplitude=po_s.amplitude, multipliers=[float(abs(v)) for v in po_s.multipliers]),
             unstable=dict(period=po_u.period, amplitude=po_u.amplitude, multipliers=[float(abs(v)) for v in po_u.multipliers]))
         lp = preset(name, K=k_unstable)
-        plot_branch(br, title=f"Fig. 8.{3 if short == 'lugre' else 5}: {short} loop, hunting branch in K",
-                    equilibrium_stable=(np.array([0.0321, 1.0]), np.array([True, True])),
-                    path=out / f"fig8_{3 if short == 'lugre' else 5}.png")
+        if short == "lugre":     # Fig. 8.5 is drawn below, with the event-map circles added
+            plot_branch(br, title="Fig. 8.3: lugre loop, hunting branch in K",
+                        equilibrium_stable=(np.array([0.0321, 1.0]), np.array([True, True])),
+                        path=out / "fig8_3.png")
         plot_cycles(lp.system, [po_s, po_u], [f"stable, K = {k_unstable}", f"unstable, K = {k_unstable}"],
                     title=f"Fig. 8.{4 if short == 'lugre' else 6}: {short} cycles at K = {k_unstable}",
                     eq_bounds=preset("table8.1-switch", K=k_unstable).equilibrium_set(),
