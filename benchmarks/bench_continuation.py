@@ -6,7 +6,7 @@
    by forward differences: n + 1 integrations per Newton step), both from the same guess.
 2. Both branches of chapter 8 from K = 0.05 through the cyclic fold and back along the unstable
    branch (LuGre to K = 0.615, Switch to K = 0.634): wall time and fold location.
-AUTO-07p is not installed on this machine, so it is not compared here.
+AUTO-07p is compared in bench_auto.py (where it is installed).
 
     python benchmarks/bench_continuation.py
 """

@@ -1,6 +1,6 @@
 !---------------------------------------------------------------------------------------------
 ! AUTO-07p equations of the chapter-8 LuGre loop (Table 8.1) for benchmarks/bench_auto.py.
-! |x2| is smoothed as sqrt(x2^2 + eps^2) (PAR(2) = eps), as AUTO needs a smooth vector field.
+! |x2| is smoothed as sqrt(x2^2 + eps^2) (eps = 10**PAR(2), so continuation in eps is in decades), as AUTO needs a smooth vector field.
 ! PAR(1) = K, PAR(11) = period. U(4) = sigma0 z (the bristle force, N m) keeps the unknowns of
 ! comparable size for AUTO's Newton iteration.
 !---------------------------------------------------------------------------------------------
@@ -15,7 +15,7 @@ SUBROUTINE FUNC(NDIM,U,ICP,PAR,IJAC,F,DFDU,DFDP)
   DOUBLE PRECISION, PARAMETER :: S0 = 2.2D4, S1 = 7.58D0, S2 = 0.1D0
   DOUBLE PRECISION K, EPS, V, AV, G, ZD, FF, UC
   K = PAR(1)
-  EPS = PAR(2)
+  EPS = 10.D0**PAR(2)
   V = U(2)
   AV = SQRT(V * V + EPS * EPS)
   G = FC + (FS - FC) * EXP(-(V / VS)**2)
@@ -34,7 +34,7 @@ SUBROUTINE STPNT(NDIM,U,PAR,T)
   DOUBLE PRECISION, INTENT(INOUT) :: U(NDIM), PAR(*)
   DOUBLE PRECISION, INTENT(IN) :: T
   PAR(1) = 0.3D0
-  PAR(2) = 1.D-6
+  PAR(2) = -9.D0
 END SUBROUTINE STPNT
 
 SUBROUTINE BCND

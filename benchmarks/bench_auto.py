@@ -1,0 +1,103 @@
+"""The chapter-8 LuGre branch by hunting and by AUTO-07p (issue: continuation, performance).
+
+Both follow the hunting cycles of the Table 8.1 LuGre loop from K = 0.05 through the cyclic fold
+and back along the unstable branch to K = 0.615, in the same process:
+
+- hunting: single shooting on the exact (non-smooth) loop, DOP853 with variational equations and
+  events at x2 = 0, pseudo-arclength continuation, fold refined by bisection of the tangent;
+- AUTO-07p (Debian package ``auto-07p`` with gfortran): orthogonal collocation (NCOL = 4) on the
+  loop with |x2| smoothed as sqrt(x2^2 + eps^2), eps = 1e-9 m/s (benchmarks/auto/lugre.f90). Its
+  starting orbit is hunting's cycle at K = 0.05, written at every accepted integration step: a
+  uniform sampling misses the presliding oscillations (period 7 ms, the cycle lasts 10-19 s) and
+  AUTO's first Newton iteration then fails (MX).
+
+Skipped with a message when AUTO-07p is not installed.
+
+    python benchmarks/bench_auto.py
+"""
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from hunting.continuation import find_cycle, follow
+from hunting.continuation.shooting import ShootingOptions
+from hunting.integrate.simulate import simulate
+from hunting.models import preset
+
+AUTO_DIR = Path(os.environ.get("AUTO_DIR", "/usr/lib/auto-07p"))
+F90 = Path(__file__).parent / "auto" / "lugre.f90"
+K_START, K_BACK, LOG10_EPS = 0.05, 0.615, -9.0
+
+
+def write_start(path: Path, K: float) -> None:
+    """hunting's cycle at K as AUTO starting data: t, x1, x2, x3, sigma0 z at every step."""
+    loop = preset("table8.1-lugre", K=K)
+    po = find_cycle("table8.1-lugre", {"K": K})
+    tr = simulate(loop.system, po.x0, (0.0, po.period), rtol=1e-11, atol=1e-13)
+    keep = np.concatenate([[True], np.diff(tr.t) > 1e-12])
+    t, x = tr.t[keep], tr.x[keep].copy()
+    x[:, 3] *= loop.friction.sigma0
+    x[-1] = x[0]
+    np.savetxt(path, np.column_stack([t, x]))
+
+
+def run_auto(ntst: int, workdir: Path) -> tuple[float, float, int]:
+    """(wall time [s], fold K, points) of AUTO's branch with NTST mesh intervals."""
+    sys.path.insert(0, str(AUTO_DIR / "python"))
+    import auto  # noqa: PLC0415  (only where AUTO-07p exists)
+    cwd = os.getcwd()
+    os.chdir(workdir)
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            t0 = time.perf_counter()
+            b = auto.run(e="lugre", dat="lugre", IPS=2, NDIM=4, ICP=[1, 11], NTST=ntst, NCOL=4, IAD=3,
+                         ILP=1, ISP=2, DS=0.01, DSMIN=1e-7, DSMAX=0.02, NMX=2000, NPR=10000,
+                         EPSL=1e-7, EPSU=1e-7, EPSS=1e-4, ITNW=12, NWTN=3, ITMX=8, JAC=0, NPAR=11,
+                         THL={11: 0.0}, UZR={1: K_BACK}, STOP=["UZ2"], UZSTOP={1: [0.04, 0.9]},
+                         PAR={1: K_START, 2: LOG10_EPS})
+            wall = time.perf_counter() - t0
+    finally:
+        os.chdir(cwd)
+    folds = b("LP")
+    return wall, (float(folds[0]["PAR(1)"]) if folds else float("nan")), len(b.data[0])
+
+
+def main() -> None:
+    rows = []
+    find_cycle("table8.1-lugre", {"K": K_START})                     # load the compiled kernels
+    for rtol in (1e-9, 1e-11):
+        so = ShootingOptions(rtol=rtol, atol=rtol * 1e-2)
+        t0 = time.perf_counter()
+        br = follow("table8.1-lugre", "K", K_START, 1.0, stop_at=K_BACK, shooting=so)
+        wall = time.perf_counter() - t0
+        fold = [s.param for s in br.special if s.kind == "fold"]
+        rows.append((f"hunting shooting, DOP853 rtol {rtol:.0e}", wall, fold[0] if fold else float("nan"),
+                     len(br.mu)))
+    if not (AUTO_DIR / "python" / "auto").is_dir() or shutil.which("gfortran") is None:
+        print(f"AUTO-07p not found at {AUTO_DIR} (or no gfortran): only hunting's numbers")
+    else:
+        with tempfile.TemporaryDirectory() as tmp:
+            work = Path(tmp)
+            shutil.copy(F90, work / "lugre.f90")
+            write_start(work / "lugre.dat", K_START)
+            run_auto(300, work)                                     # compile the equations once
+            for ntst in (1000, 2000, 4000):
+                wall, fold, npts = run_auto(ntst, work)
+                rows.append((f"AUTO-07p collocation, NTST {ntst}, eps 1e-9", wall, fold, npts))
+    print(f"LuGre branch K = {K_START} -> fold -> {K_BACK} (thesis fold 0.620)")
+    print(f"{'method':<44} {'wall [s]':>9} {'fold K':>12} {'points':>7}")
+    for name, wall, fold, npts in rows:
+        print(f"{name:<44} {wall:9.2f} {fold:12.7f} {npts:7d}")
+
+
+if __name__ == "__main__":
+    main()
