@@ -63,22 +63,37 @@ def _check_signals(u, y, fs):
 
 
 def estimate_frf(u, y, fs: float, *, nperseg: int = 8192, overlap: float = 0.5) -> FRF:
-    """H1 estimate of the FRF from input u to output y sampled at fs [Hz]."""
-    u, y = _check_signals(u, y, fs)
-    if u.size < nperseg:
-        raise SystemDefinitionError(f"signals have {u.size} samples, fewer than nperseg = {nperseg}")
+    """H1 estimate of the FRF from input u to output y sampled at fs [Hz]: averaged periodograms
+    with a Hann window and ``overlap`` (sections 4.4, 10.3.1).
+
+    u, y : (n,) arrays, or lists of arrays (fragments, e.g. the parts of a record between
+    velocity reversals): the cross and auto spectra are averaged over all segments of all
+    fragments, weighted by their number of segments; fragments shorter than nperseg are skipped."""
+    frags = list(zip(u, y)) if isinstance(u, (list, tuple)) else [(u, y)]
     if not 0 <= overlap < 1:
         raise SystemDefinitionError(f"overlap = {overlap!r} must be in [0, 1)")
     nov = int(round(overlap * nperseg))
-    f, Puu = signal.welch(u, fs, window="hann", nperseg=nperseg, noverlap=nov, detrend="constant")
-    _, Puy = signal.csd(u, y, fs, window="hann", nperseg=nperseg, noverlap=nov, detrend="constant")
-    _, Pyy = signal.welch(y, fs, window="hann", nperseg=nperseg, noverlap=nov, detrend="constant")
+    acc, n_avg = None, 0
+    for uf, yf in frags:
+        uf, yf = _check_signals(uf, yf, fs)
+        if uf.size < nperseg:
+            continue
+        kw = dict(fs=fs, window="hann", nperseg=nperseg, noverlap=nov, detrend="constant")
+        f, Puu = signal.welch(uf, **kw)
+        _, Puy = signal.csd(uf, yf, **kw)
+        _, Pyy = signal.welch(yf, **kw)
+        k = 1 + (uf.size - nperseg) // (nperseg - nov)
+        part = np.array([Puu * k, Puy * k, Pyy * k])
+        acc = part if acc is None else acc + part
+        n_avg += k
+    if acc is None:
+        raise SystemDefinitionError(f"every signal (fragment) has fewer than nperseg = {nperseg} samples")
+    Puu, Puy, Pyy = acc / n_avg
     with np.errstate(divide="ignore", invalid="ignore"):
         H = Puy / Puu
-        coh = np.abs(Puy) ** 2 / (Puu * Pyy)
+        coh = np.abs(Puy) ** 2 / (Puu.real * Pyy.real)
     keep = f > 0
-    n_avg = 1 + (u.size - nperseg) // (nperseg - nov)
-    return FRF(f[keep], H[keep], np.clip(np.nan_to_num(coh[keep]), 0, 1), int(n_avg))
+    return FRF(f[keep], H[keep], np.clip(np.nan_to_num(coh[keep].real), 0, 1), int(n_avg))
 
 
 def controller_frf(controller, f) -> np.ndarray:
