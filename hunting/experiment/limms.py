@@ -264,13 +264,13 @@ class IdentifiedLiMMS:
 
     def loop(self, K: float, model: str = "switch") -> ServoLoop:
         """The identified closed loop at gain K [V/m]: model "switch" or "lugre"."""
+        if model not in ("switch", "lugre"):
+            raise SystemDefinitionError(f"model = {model!r} is not allowed: use 'switch' or 'lugre'")
         plant = Plant(mass=self.m, motor_constant=self.cm, setpoint=Q_D, cogging=self.cogging)
         if model == "switch":
             fr = Switch(self.curve)
-        elif model == "lugre":
-            fr = LuGre(self.curve, sigma0=self.presliding.values["sigma0"], sigma1=self.presliding.values["sigma1"])
         else:
-            raise SystemDefinitionError(f"model = {model!r} is not allowed: use 'switch' or 'lugre'")
+            fr = LuGre(self.curve, sigma0=self.presliding.values["sigma0"], sigma1=self.presliding.values["sigma1"])
         return ServoLoop(plant, fr, PID.fixed_shape(K), name=f"identified LiMMS ({model}, K={K:g})")
 
     def table(self, motor: VirtualMotor) -> list[tuple[str, float, float, float]]:
