@@ -1,8 +1,9 @@
 """Stick-to-stick event maps, their fixed points, basins and bifurcation diagrams."""
+from .attractors import Attractor, attractors
 from .basins import basins
 from .bifurcation import MapDiagram, default_grid, map_diagram
 from .engine import EventMap, MapOptions, MapValues, evaluate_map, event_map, stick_map
 from .fixedpoints import FixedPoint, OriginSlope, fixed_points, origin_slope
 
-__all__ = ["basins", "MapDiagram", "default_grid", "map_diagram", "EventMap", "MapOptions", "MapValues",
+__all__ = ["Attractor", "attractors", "basins", "MapDiagram", "default_grid", "map_diagram", "EventMap", "MapOptions", "MapValues",
            "evaluate_map", "event_map", "stick_map", "FixedPoint", "OriginSlope", "fixed_points", "origin_slope"]
