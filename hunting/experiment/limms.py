@@ -190,9 +190,11 @@ def regulator_experiment(motor: VirtualMotor, K: float, d0: float, duration: flo
 
 
 def stick_phases(rec: Record, resolution: float, *, window: float = 0.03, counts: int = 2,
-                 moved: float = 20e-6) -> list[tuple[int, int]]:
+                 moved: float = 60e-6) -> list[tuple[int, int]]:
     """Stick phases in a measured record: maximal runs where the measured position stays within
-    ``counts`` encoder counts for at least ``window`` s, after moving more than ``moved`` [m].
+    ``counts`` encoder counts for at least ``window`` s, after moving more than ``moved`` [m]
+    from the previous one (more than the presliding range 2 Fs / sigma0 ~ 45 um, which the
+    mass creeps through while the integral action loads the bristles).
     Returns (first, last) sample indices. (With presliding there is no exact stick; the thesis
     decides it by inspection.)"""
     y = rec.y
@@ -313,3 +315,58 @@ def identify(motor: VirtualMotor, *, seed: int = 0) -> IdentifiedLiMMS:
     return IdentifiedLiMMS(motor.cm, mass, fric, cog, pre, q_star,
                            records=dict(sensitivity=rec_s, S=S, P=P, cogging=(rec_c, rv, cruise),
                                         friction_map=(v, F), presliding=rec_p, presliding_frf=H))
+
+
+# ------------------------------------------------------------------ bifurcation diagram by simulation
+@dataclass(frozen=True)
+class MeasuredAttractor:
+    """What a long regulator run of the motor settles to at gain K [V/m]: ``stick_errors`` (k,)
+    of one period in order (period k; 0 when no period <= 32 is found within ``tol`` [m]),
+    ``at_rest`` when the motion has stopped (no slip in the recorded window), ``n_sticks``
+    stick phases recorded, ``amplitude`` max |e| [m] over the window."""
+
+    K: float
+    period: int
+    stick_errors: np.ndarray
+    at_rest: bool
+    n_sticks: int
+    amplitude: float
+
+    def as_dict(self) -> dict:
+        return dict(K=self.K, period=self.period, stick_errors=[float(v) for v in self.stick_errors],
+                    at_rest=self.at_rest, n_sticks=self.n_sticks, amplitude=self.amplitude)
+
+
+def measured_attractor(motor: VirtualMotor, K: float, d0: float, *, t_settle: float = 40.0,
+                       t_record: float = 40.0, tol: float = 8e-6, rest: float = 1e-4,
+                       seed: int = 7) -> MeasuredAttractor:
+    """Run the regulator from rest at error d0 for t_settle + t_record s and read the stick errors
+    of the last t_record s as the thesis reads its measured limit cycles (Fig. 10.12a). The motor
+    counts as at rest when |e| stays below ``rest`` [m] over the second half of the window (near
+    the equilibrium set, quantization and the integral action still cause micro-slips of a few
+    tens of um now and then)."""
+    rec = regulator_experiment(motor, K, d0, t_settle + t_record, seed=seed, hold=False)
+    n0 = int(t_settle * motor.fs)
+    e = rec.y - Q_D
+    tail = Record(rec.t[n0:], rec.y[n0:], rec.u[n0:], rec.uc[n0:], rec.r[n0:], rec.v[n0:], rec.q[n0:],
+                  rec.qd[n0:], rec.z[n0:], rec.state, rec.ctrl_state)
+    amp = float(np.max(np.abs(e[n0:])))
+    half = n0 + (e.size - n0) // 2
+    ph = stick_phases(tail, motor.resolution)
+    if np.max(np.abs(e[half:])) < rest:
+        return MeasuredAttractor(K, 0, np.zeros(0), True, 0, amp)
+    d = np.array([tail.y[a] - Q_D for a, _ in ph])
+    period = 0
+    for p in range(1, min(32, d.size // 2) + 1):
+        if np.all(np.abs(d[p:] - d[:-p]) <= tol):
+            period = p
+            break
+    pts = d[-period:] if period else d
+    return MeasuredAttractor(K, period, pts, False, int(d.size), amp)
+
+
+def measured_diagram(motor: VirtualMotor, K_values, d0: float = 0.01, *, workers: int = 2, **kw) -> list:
+    """measured_attractor over gains K (runs in ``workers`` threads; the simulator releases the GIL)."""
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=max(1, workers)) as ex:
+        return list(ex.map(lambda K: measured_attractor(motor, float(K), d0, **kw), K_values))

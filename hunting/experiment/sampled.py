@@ -34,7 +34,7 @@ def _plant_rates(q, v, z, u, p):
     return v, (p[1] * u - fcog - F) / p[0], zdot
 
 
-@numba.njit(cache=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy", nogil=True)
 def _run(p, x, ctrl, cstate, r, vinj, uff, noise, resolution, dt, substeps, u_max,
          y_out, u_out, uc_out, x_out):
     """Advance n = r.size samples. x (3,) plant state [q, v, z] and cstate (3,) controller state
