@@ -156,14 +156,19 @@ def nonpassive_intervals(curve, b_star: float, v) -> list:
 
 def lugre_equilibrium_eigenvalues(loop: ServoLoop, beta_frac: float, q: float) -> np.ndarray:
     """Eigenvalues of the generalized (Clarke) Jacobian (1 - q) J- + q J+ of the LuGre loop at
-    the equilibrium x = beta [0, 0, -sigma0/(cm ki), 1] (x3 from the integral action balancing
-    sigma0 beta; thesis sections 4.3, 8.4.1), beta = beta_frac * Fs / sigma0."""
+    the equilibrium x = [0, 0, -(F_cog(q_d) + sigma0 beta)/(cm ki), beta] (the integral action
+    balancing the bristle force and the cogging force; thesis sections 4.3, 8.4.1, 10.4.2), with
+    beta = beta_frac * Fs / sigma0 and Fs of the direction of beta (direction-dependent curves
+    bound the bristle deflection by Fs+ / sigma0 and -Fs- / sigma0)."""
     from .models import servo as S
     from .models.friction import LuGre
     if not isinstance(loop.friction, LuGre):
         raise SystemDefinitionError(f"{loop.name}: the generalized Jacobian applies to LuGre loops")
-    beta = beta_frac * loop.friction.curve.positive.Fs / loop.friction.sigma0
-    x = np.array([0.0, 0.0, -loop.friction.sigma0 * beta / (loop.plant.motor_constant * loop.controller.ki), beta])
+    curve = loop.friction.curve.positive if beta_frac >= 0 else loop.friction.curve.negative
+    beta = beta_frac * curve.Fs / loop.friction.sigma0
+    pl = loop.plant
+    fcog = 0.0 if pl.cogging is None else float(pl.cogging(pl.setpoint)[0])
+    x = np.array([0.0, 0.0, -(fcog + loop.friction.sigma0 * beta) / (pl.motor_constant * loop.controller.ki), beta])
     p = loop.system.params
     Jp, Jm = np.empty((4, 4)), np.empty((4, 4))
     S.servo_jac(S.V_POS, 0.0, x, p, Jp)

@@ -6,7 +6,7 @@
                      [--json FILE] [--plot FILE]
     hunting continue PRESET [--set NAME=VALUE ...] --param NAME --from A --to B [--back-to C]
                      [--json FILE] [--plot FILE]
-    hunting reproduce ch8|ch9 [--out DIR]   a thesis chapter: tables and figures, checked
+    hunting reproduce ch8|ch9|ch10 [--out DIR]   a thesis chapter: tables and figures, checked
     hunting demo [--out DIR]            short simulations of chapters 4, 8 and 9, checked
 """
 from __future__ import annotations
@@ -117,7 +117,7 @@ def _cmd_continue(args) -> int:
 
 def _cmd_reproduce(args) -> int:
     import importlib
-    chapters = {"ch8": "hunting.reproduce.ch8", "ch9": "hunting.reproduce.ch9"}
+    chapters = {"ch8": "hunting.reproduce.ch8", "ch9": "hunting.reproduce.ch9", "ch10": "hunting.reproduce.ch10"}
     if args.chapter not in chapters:
         raise HuntingError(f"chapter {args.chapter!r} is not available: choose from {sorted(chapters)}")
     mod = importlib.import_module(chapters[args.chapter])
@@ -159,7 +159,7 @@ def main(argv=None) -> int:
     cp.add_argument("--json")
     cp.add_argument("--plot")
     rp = sub.add_parser("reproduce", help="reproduce a thesis chapter (tables, figures, checks)")
-    rp.add_argument("chapter", help="ch8 or ch9")
+    rp.add_argument("chapter", help="ch8, ch9 or ch10")
     rp.add_argument("--out")
     dp = sub.add_parser("demo", help="hunting cycles of chapters 8 and 9, checked against the thesis")
     dp.add_argument("--out", default="out/demo")

@@ -266,3 +266,61 @@ def plot_cycles(system, orbits, labels, *, title: str = "", path=None, eq_bounds
     if path is not None:
         save(fig, path)
     return fig
+
+
+def plot_frf(curves, *, title: str = "", path=None, unit: str = ""):
+    """Bode plot of FRFs: curves is a list of (f [Hz], H complex, label, style) tuples."""
+    plt = _plt()
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.6), sharex=True)
+    for f, H, label, style in curves:
+        a1.loglog(f, np.abs(H), style, lw=1.1, ms=2, label=label)
+        a2.semilogx(f, np.degrees(np.angle(H)), style, lw=1.1, ms=2)
+    a1.set_ylabel(f"|H| [{unit}]" if unit else "|H|")
+    a2.set_ylabel("phase [deg]")
+    a2.set_yticks([-180, -90, 0, 90, 180])
+    a2.set_xlabel("f [Hz]")
+    for a in (a1, a2):
+        a.grid(alpha=0.3, which="both")
+    a1.legend(fontsize=8)
+    if title:
+        a1.set_title(title, fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        save(fig, path)
+    return fig
+
+
+def plot_attractor_diagram(values, attractors_per_value, *, param: str = "K", title: str = "", ax=None,
+                           path=None, unit: str = "m", scale: float = 1.0):
+    """Stick errors of the attracting cycles against the parameter (one dot per stick phase of a
+    period, as in thesis Fig. 10.12); squares at 0 where the equilibrium set attracts. Entries of
+    ``attractors_per_value`` are lists of objects with ``kind`` ("cycle", "equilibrium",
+    "irregular") and ``d`` (stick errors)."""
+    plt = _plt()
+    own = ax is None
+    if own:
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    else:
+        fig = ax.figure
+    labelled = set()
+    for v, atts in zip(values, attractors_per_value):
+        for a in atts:
+            lab = None
+            if a.kind == "equilibrium":
+                lab = "equilibrium set attracts" if "eq" not in labelled else None
+                labelled.add("eq")
+                ax.plot(v, 0.0, "s", mfc="w", mec="C0", ms=6, label=lab)
+            else:
+                irr = a.kind == "irregular"
+                key = "irr" if irr else "cyc"
+                lab = (("irregular (no period <= 64)" if irr else "stable cycle: stick errors")
+                       if key not in labelled else None)
+                labelled.add(key)
+                d = np.asarray(a.d) * scale
+                ax.plot(np.full(d.size, v), d, ".", color="0.6" if irr else "k", ms=2 if irr else 4, label=lab)
+    ax.set_xlabel(param)
+    ax.set_ylabel(f"stick error [{unit}]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    _finish(fig, ax, own, title, path)
+    return fig

@@ -169,3 +169,22 @@ def test_reproduce_ch9_matches_the_thesis(tmp_path):
     assert all(r["ok"] for r in data["checks"]) and len(data["checks"]) >= 30
     for name in ("fig9_4", "fig9_5", "fig9_6", "fig9_7", "fig9_8", "fig11_1", "fig11_3"):
         assert (tmp_path / f"{name}.png").stat().st_size > 20000
+
+
+def test_attractors_find_the_table_9_2_cycle_and_the_equilibrium():
+    """Iterating P finds the stable cycle of Table 9.2 (period 2, d3* = 0.2523, P^2 slope
+    0.783) from starts outside the unstable cycle, and the equilibrium set from starts inside."""
+    from hunting.eventmap import attractors
+    loop = hunting.preset("table9.1")
+    atts = attractors(loop, [0.001, -0.002, 0.05, 0.3, -0.4])
+    kinds = {a.kind for a in atts}
+    assert kinds == {"equilibrium", "cycle"}
+    cyc = next(a for a in atts if a.kind == "cycle")
+    assert cyc.period == 2
+    assert np.sort(np.abs(cyc.d)) == pytest.approx([0.2523048, 0.2523048], abs=1e-6)
+    assert cyc.multiplier == pytest.approx(0.7829, abs=2e-3)
+    assert cyc.basin == 3
+    eq = next(a for a in atts if a.kind == "equilibrium")
+    assert eq.basin == 2
+    with pytest.raises(hunting.SystemDefinitionError, match="starts"):
+        attractors(loop, [np.nan])

@@ -77,10 +77,9 @@ def attractors(loop: ServoLoop, starts, *, transient: int = 100, max_period: int
                                              and np.max(np.abs(col[-8:])) < 1e-3 * scale):
             kind, per, pts = "equilibrium", 0, np.zeros(0)
         else:
-            thr = tol * scale
-            per = next((k for k in range(1, max_period + 1) if abs(col[k] - col[0]) <= thr), 0)
+            per, pts = _period(loop, col, max_period, tol * scale, opt)
             kind = "cycle" if per else "irregular"
-            pts = col[:per] if per else col[1:]
+            pts = pts if per else col[1:]
         same = next((a for a in found if a.kind == kind and a.period == per
                      and (kind == "equilibrium" or kind == "irregular" or
                           np.min(np.abs(a.d - pts[0])) <= 10 * tol * scale)), None)
@@ -99,3 +98,31 @@ def attractors(loop: ServoLoop, starts, *, transient: int = 100, max_period: int
             mult = float(np.prod((plus - minus) / (2 * h)))
         out.append(Attractor(a.kind, a.period, a.d, mult, a.basin))
     return sorted(out, key=lambda a: a.amplitude)
+
+
+def _period(loop, col, max_period, tol, opt):
+    """Smallest period k of the iterates col (k, orbit) once the fixed point of P^k near col[0]
+    is polished by Newton's method (slowly contracting cycles are far from converged after the
+    transient); (0, None) when no k <= max_period works."""
+    scale = max(float(np.max(np.abs(col))), 1e-300)
+    for k in range(1, max_period + 1):
+        if abs(col[k] - col[0]) > 1e-3 * scale:
+            continue
+        d = float(col[0])
+        for _ in range(30):                      # Newton on g(d) = P^k(d) - d
+            h = 1e-7 * max(abs(d), opt.d_floor)
+            mv = evaluate_map(loop, [d, d + h, d - h], k, opt)
+            if not np.all(mv.ok):
+                break
+            g = mv.image[0] - d
+            if abs(g) <= tol:
+                orbit = [d]
+                for _ in range(k - 1):
+                    nxt = evaluate_map(loop, [orbit[-1]], 1, opt)
+                    orbit.append(float(nxt.image[0]))
+                return k, np.array(orbit)
+            dg = (mv.image[1] - mv.image[2]) / (2 * h) - 1.0
+            if dg == 0 or not np.isfinite(dg):
+                break
+            d = d - g / dg
+    return 0, None

@@ -224,18 +224,20 @@ def stick_phases(rec: Record, resolution: float, *, window: float = 0.03, counts
     return phases
 
 
-def experimental_event_map(motor: VirtualMotor, K: float, grid, *, t_max: float = 20.0,
-                           seed: int = 6) -> tuple[np.ndarray, np.ndarray]:
+def experimental_event_map(motor: VirtualMotor, K: float, grid, *, t_max: float = 20.0, seed: int = 6,
+                           workers: int = 2) -> tuple[np.ndarray, np.ndarray]:
     """The "experimental" event map of section 10.4.3: for each d in grid, hold the mass at
     q_d + d with the strong PID, switch to the regulator (fresh integrator), and record the
     error at the next stick. Returns (d, d_next) with NaN where no stick came within t_max."""
+    from concurrent.futures import ThreadPoolExecutor
     grid = np.asarray(grid, float)
-    out = np.full(grid.size, np.nan)
-    for i, d in enumerate(grid):
-        rec = regulator_experiment(motor, K, float(d), t_max, seed=seed + i)
+
+    def one(i):
+        rec = regulator_experiment(motor, K, float(grid[i]), t_max, seed=seed + i)
         ph = stick_phases(rec, motor.resolution)
-        if ph:
-            out[i] = rec.y[ph[0][0]] - Q_D
+        return rec.y[ph[0][0]] - Q_D if ph else np.nan
+    with ThreadPoolExecutor(max_workers=max(1, workers)) as ex:
+        out = np.array(list(ex.map(one, range(grid.size))), float)
     return grid, out
 
 
