@@ -274,10 +274,11 @@ def plot_frf(curves, *, title: str = "", path=None, unit: str = ""):
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 5.6), sharex=True)
     for f, H, label, style in curves:
         a1.loglog(f, np.abs(H), style, lw=1.1, ms=2, label=label)
-        a2.semilogx(f, np.degrees(np.angle(H)), style, lw=1.1, ms=2)
+        ph = np.degrees(np.angle(H))
+        a2.semilogx(f, np.where(ph > 1e-9, ph - 360.0, ph), style, lw=1.1, ms=2)   # in (-360, 0]
     a1.set_ylabel(f"|H| [{unit}]" if unit else "|H|")
     a2.set_ylabel("phase [deg]")
-    a2.set_yticks([-180, -90, 0, 90, 180])
+    a2.set_yticks([-360, -270, -180, -90, 0])
     a2.set_xlabel("f [Hz]")
     for a in (a1, a2):
         a.grid(alpha=0.3, which="both")
