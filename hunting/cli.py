@@ -8,6 +8,8 @@
                      [--json FILE] [--plot FILE]
     hunting reproduce ch8|ch9|ch10 [--out DIR]   a thesis chapter: tables and figures, checked
     hunting demo [--out DIR]            short simulations of chapters 4, 8 and 9, checked
+    hunting diagnose DATA --model MODEL.json [--validate DATA2] [--json FILE] [--report DIR]
+                     [--names KEY=COLUMN,...] [--drop COLUMN]   measured data against the model
 """
 from __future__ import annotations
 
@@ -124,6 +126,42 @@ def _cmd_reproduce(args) -> int:
     return mod.run(Path(args.out or f"out/{args.chapter}"))
 
 
+def _parse_names(text, drop) -> dict | None:
+    names = {}
+    for item in (text.split(",") if text else []):
+        if "=" not in item:
+            raise HuntingError(f"--names {item!r} is not KEY=COLUMN")
+        k, v = item.split("=", 1)
+        names[k.strip()] = v.strip()
+    for d in drop or []:
+        names[d] = None
+    return names or None
+
+
+def _cmd_diagnose(args) -> int:
+    from .diagnose import NominalModel, diagnose, load
+    from .diagnose.report import write_json, write_report
+    names = _parse_names(args.names, args.drop)
+    fit = load(args.data, names)
+    val = load(args.validate, names) if args.validate else None
+    model = NominalModel.from_json(args.model)
+    dg = diagnose(fit, model, val)
+    print(f"validation force-residual RMS: nominal {dg.nominal:.4g} N -> extended {dg.extended:.4g} N")
+    print(f"criterion: {dg.criterion}")
+    if not dg.causes:
+        print("no cause found: the nominal model explains the data within the criterion")
+    for i, c in enumerate(dg.causes):
+        pars = ", ".join(f"{k} = {v:.5g} +- {c.sigma.get(k, float('nan')):.2g}" for k, v in c.parameters.items())
+        print(f"  {i + 1}. {c.name:<10} score {c.score:.3g}  p {c.p_value:.2g}  {pars}")
+    for a in dg.alternatives:
+        print(f"     (also explains the data alone: {a['name']} {a['parameters']}; absorbed by {a['absorbed_by']})")
+    if args.json:
+        write_json(dg, args.json)
+    if args.report:
+        print(f"report: {write_report(dg, args.report)}")
+    return 0
+
+
 def _cmd_demo(args) -> int:
     from .demo import run_demo
     return run_demo(Path(args.out))
@@ -163,10 +201,19 @@ def main(argv=None) -> int:
     rp.add_argument("--out")
     dp = sub.add_parser("demo", help="hunting cycles of chapters 8 and 9, checked against the thesis")
     dp.add_argument("--out", default="out/demo")
+    gp = sub.add_parser("diagnose", help="measured data against the model: causes, extension, gain")
+    gp.add_argument("data", help="CSV (header t,q,u[,q_ref,f_ext]), .npz or .mat")
+    gp.add_argument("--model", required=True, help="MODEL.json (see hunting.diagnose.model)")
+    gp.add_argument("--validate", help="validation data (default: the last 40 %% of DATA)")
+    gp.add_argument("--names", help="column names in the files, e.g. q=qm,u=vir")
+    gp.add_argument("--drop", action="append", help="leave this column out (e.g. f_ext)")
+    gp.add_argument("--json")
+    gp.add_argument("--report", help="directory for index.html, residual.png, diagnosis.json")
     args = ap.parse_args(argv)
     try:
         return {"models": _cmd_models, "simulate": _cmd_simulate, "eventmap": _cmd_eventmap,
-                "continue": _cmd_continue, "reproduce": _cmd_reproduce, "demo": _cmd_demo}[args.cmd](args)
+                "continue": _cmd_continue, "reproduce": _cmd_reproduce, "demo": _cmd_demo,
+                "diagnose": _cmd_diagnose}[args.cmd](args)
     except HuntingError as e:
         print(f"hunting: error: {e}", file=sys.stderr)
         return 2

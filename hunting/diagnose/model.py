@@ -1,0 +1,163 @@
+"""The nominal model a diagnosis starts from: plant, friction law, controller, read from the
+MODEL.json schema of ``hunting diagnose`` (or a preset), with the static friction map the force
+residual needs.
+
+Schema (keys beyond these are errors, so typos are caught):
+
+    {"preset": "table9.1", "set": {"P": 60.0}}
+    {"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 0.0},
+     "friction": {"law": "coulomb-viscous" | "stribeck" | "switch" | "lugre",
+                  "Fc": .., "Fs": .., "vs": .., "beta": .., "b": .., "sigma0": .., "sigma1": ..,
+                  "sigma2": (alias of b), "Fc_neg": .., ... (direction-dependent values)},
+     "controller": {"type": "pid", "form": "PDI" | "K", ...} | {"type": "pd-velocity-loop", ...}}
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SystemDefinitionError, check_finite, check_finite_positive
+from ..models.friction import DirectionalCurve, LuGre, StribeckCurve
+
+LAWS = ("coulomb-viscous", "stribeck", "switch", "lugre")
+_FRICTION_KEYS = {"law", "Fc", "Fs", "vs", "beta", "b", "sigma0", "sigma1", "sigma2",
+                  "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg"}
+_PLANT_KEYS = {"mass", "motor_constant", "offset"}
+_CONTROLLER_TYPES = ("pid", "pd-velocity-loop")
+
+
+@dataclass(frozen=True)
+class NominalModel:
+    """mass [kg or kg m^2]; cm : motor constant [N/V] (1 if u is a force); curve : the static
+    friction-velocity map (per direction); law : its name; offset [N] : constant force (plant
+    equation m q'' = cm u + f_ext - F(q') - offset); sigma0, sigma1 : LuGre parameters when the
+    law is lugre; controller : the controller description (dict), or None; source : the dict."""
+
+    mass: float
+    cm: float
+    curve: DirectionalCurve
+    law: str = "coulomb-viscous"
+    offset: float = 0.0
+    sigma0: float | None = None
+    sigma1: float | None = None
+    controller: dict | None = None
+    source: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        check_finite_positive("mass", self.mass)
+        check_finite_positive("motor_constant", self.cm)
+        check_finite("offset", self.offset)
+        if self.law not in LAWS:
+            raise SystemDefinitionError(f"friction law = {self.law!r} is not allowed: use one of {LAWS}")
+
+    def friction(self, v) -> np.ndarray:
+        """Static friction force F(v) [N] (0 at v = 0, where it is set-valued)."""
+        v = np.asarray(v, dtype=float)
+        pos, neg = self.curve.positive, self.curve.negative
+        out = np.zeros_like(v)
+        p, n = v > 0, v < 0
+        out[p] = pos.level(v[p]) + pos.b * v[p]
+        out[n] = -neg.level(-v[n]) + neg.b * v[n]
+        return out
+
+    def to_dict(self) -> dict:
+        c = self.curve
+        fr = {"law": self.law, "Fc": c.positive.Fc, "Fs": c.positive.Fs, "vs": c.positive.vs,
+              "beta": c.positive.beta, "b": c.positive.b}
+        if not c.symmetric:
+            fr.update(Fc_neg=c.negative.Fc, Fs_neg=c.negative.Fs, vs_neg=c.negative.vs,
+                      beta_neg=c.negative.beta, b_neg=c.negative.b)
+        if self.law == "lugre":
+            fr.update(sigma0=self.sigma0, sigma1=self.sigma1)
+        d = {"plant": {"mass": self.mass, "motor_constant": self.cm, "offset": self.offset}, "friction": fr}
+        if self.controller is not None:
+            d["controller"] = self.controller
+        return d
+
+    @staticmethod
+    def from_json(path) -> "NominalModel":
+        path = Path(path)
+        try:
+            d = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError) as exc:
+            raise SystemDefinitionError(f"model file {path}: {exc}") from None
+        return NominalModel.from_dict(d)
+
+    @staticmethod
+    def from_dict(d: dict) -> "NominalModel":
+        if not isinstance(d, dict):
+            raise SystemDefinitionError(f"model = {d!r} must be a JSON object")
+        unknown = set(d) - {"preset", "set", "plant", "friction", "controller"}
+        if unknown:
+            raise SystemDefinitionError(f"model: unknown keys {sorted(unknown)}; allowed: preset, set, plant, "
+                                        "friction, controller")
+        if "preset" in d:
+            from ..models import preset
+            loop = preset(d["preset"], **d.get("set", {}))
+            fr = loop.friction
+            law = "lugre" if isinstance(fr, LuGre) else "switch"
+            return NominalModel(loop.plant.mass, loop.plant.motor_constant, fr.curve, law,
+                                sigma0=getattr(fr, "sigma0", None), sigma1=getattr(fr, "sigma1", None),
+                                controller=d.get("controller"), source=d)
+        for k in ("plant", "friction"):
+            if k not in d:
+                raise SystemDefinitionError(f"model: missing {k!r} (or give a 'preset')")
+        pl, fr = dict(d["plant"]), dict(d["friction"])
+        bad = set(pl) - _PLANT_KEYS
+        if bad:
+            raise SystemDefinitionError(f"model plant: unknown keys {sorted(bad)}; allowed: {sorted(_PLANT_KEYS)}")
+        bad = set(fr) - _FRICTION_KEYS
+        if bad:
+            raise SystemDefinitionError(f"model friction: unknown keys {sorted(bad)}; allowed: {sorted(_FRICTION_KEYS)}")
+        if "mass" not in pl:
+            raise SystemDefinitionError("model plant: 'mass' is required [kg]")
+        law = fr.get("law", "coulomb-viscous")
+        if law not in LAWS:
+            raise SystemDefinitionError(f"friction law = {law!r} is not allowed: use one of {LAWS}")
+        if "sigma2" in fr:
+            fr.setdefault("b", fr.pop("sigma2"))
+        if "Fc" not in fr:
+            raise SystemDefinitionError("model friction: 'Fc' is required [N]")
+
+        def curve(sfx: str) -> StribeckCurve:
+            get = lambda k, dflt=None: fr.get(k + sfx, fr.get(k, dflt))  # noqa: E731
+            Fc = float(get("Fc"))
+            if law == "coulomb-viscous":
+                return StribeckCurve(Fc=Fc, Fs=Fc, vs=1.0, beta=2.0, b=float(get("b", 0.0)))
+            for k in ("Fs", "vs"):
+                if get(k) is None:
+                    raise SystemDefinitionError(f"model friction: {law} needs {k!r}")
+            return StribeckCurve(Fc=Fc, Fs=float(get("Fs")), vs=float(get("vs")), beta=float(get("beta", 2.0)),
+                                 b=float(get("b", 0.0)))
+        pos = curve("")
+        neg = curve("_neg") if any(k.endswith("_neg") for k in fr) else pos
+        ctrl = d.get("controller")
+        if ctrl is not None and ctrl.get("type") not in _CONTROLLER_TYPES:
+            raise SystemDefinitionError(f"controller type = {ctrl.get('type')!r} is not allowed: use one of "
+                                        f"{_CONTROLLER_TYPES}")
+        if law == "lugre" and not ("sigma0" in fr and "sigma1" in fr):
+            raise SystemDefinitionError("model friction: lugre needs 'sigma0' and 'sigma1'")
+        return NominalModel(float(pl["mass"]), float(pl.get("motor_constant", 1.0)), DirectionalCurve(pos, neg), law,
+                            offset=float(pl.get("offset", 0.0)), sigma0=fr.get("sigma0"), sigma1=fr.get("sigma1"),
+                            controller=ctrl, source=d)
+
+
+def fit_coulomb_viscous(kin, *, v_min_frac: float = 0.02) -> tuple[NominalModel, dict]:
+    """Symmetric Coulomb + viscous model without offset by least squares on the inverse dynamics
+    (IDIM-LS): force = m a + Fc sign(v) + b v on the samples with |v| > v_min_frac max|v|.
+    kin : Kinematics. Returns (model, {"mass", "Fc", "b"} standard uncertainties)."""
+    sel = np.abs(kin.v) > v_min_frac * np.max(np.abs(kin.v))
+    Phi = np.column_stack([kin.a, np.sign(kin.v), kin.v])[sel]
+    theta, *_ = np.linalg.lstsq(Phi, kin.force[sel], rcond=None)
+    r = kin.force[sel] - Phi @ theta
+    s2 = float(r @ r) / max(sel.sum() - 3, 1)
+    sd = np.sqrt(np.diag(np.linalg.inv(Phi.T @ Phi)) * s2)
+    m, Fc, b = map(float, theta)
+    curve = StribeckCurve(Fc=Fc, Fs=Fc, vs=1.0, beta=2.0, b=b)
+    model = NominalModel(m, kin.cm, DirectionalCurve(curve, curve), "coulomb-viscous")
+    return model, {"mass": float(sd[0]), "Fc": float(sd[1]), "b": float(sd[2])}
+
+

@@ -1,0 +1,63 @@
+"""Diagnosis reports: JSON (the contract of ``hunting diagnose``), figures and a small HTML page."""
+from __future__ import annotations
+
+import html
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..plotting import _plt, save
+from .select import Diagnosis
+
+
+def write_json(dg: Diagnosis, path) -> None:
+    Path(path).write_text(json.dumps(dg.as_dict(), indent=2, default=float))
+
+
+def residual_figure(dg: Diagnosis, path) -> None:
+    """Validation force residual of the nominal and the extended model against velocity,
+    position and time (the evidence: structure against v or q names the cause)."""
+    plt = _plt()
+    kv = dg.kin_val
+    fig, axes = plt.subplots(3, 1, figsize=(8, 9))
+    for r, col, lab in ((dg.r_val_nominal, "C3", f"nominal (RMS {dg.nominal:.3g} N)"),
+                        (dg.r_val_extended, "C0", f"extended (RMS {dg.extended:.3g} N)")):
+        axes[0].plot(kv.v, r, ".", ms=1.0, color=col, label=lab)
+        axes[1].plot(kv.q, r, ".", ms=1.0, color=col)
+        axes[2].plot(kv.t, r, "-", lw=0.5, color=col)
+    axes[0].set_xlabel("v [m/s]")
+    axes[1].set_xlabel("q [m]")
+    axes[2].set_xlabel("t [s]")
+    for a in axes:
+        a.set_ylabel("force residual [N]")
+        a.grid(alpha=0.3)
+    axes[0].legend(markerscale=8, fontsize=8)
+    names = ", ".join(c.name for c in dg.causes) or "none"
+    axes[0].set_title(f"validation force residual; causes found: {names}", fontsize=10)
+    fig.tight_layout()
+    save(fig, path)
+
+
+def write_report(dg: Diagnosis, directory) -> Path:
+    """JSON, the residual figure and index.html in ``directory``; returns the HTML path."""
+    d = Path(directory)
+    d.mkdir(parents=True, exist_ok=True)
+    write_json(dg, d / "diagnosis.json")
+    residual_figure(dg, d / "residual.png")
+    rows = "".join(
+        f"<tr><td>{i + 1}</td><td>{html.escape(c.name)}</td><td>{c.score:.3g}</td><td>{c.p_value:.2g}</td>"
+        f"<td>{html.escape(', '.join(f'{k} = {v:.4g} ± {c.sigma.get(k, np.nan):.2g}' for k, v in c.parameters.items()))}</td>"
+        f"<td>{c.gain['nominal']:.4g} → {c.gain['extended']:.4g}</td></tr>" for i, c in enumerate(dg.causes))
+    alt = "".join(f"<li>{html.escape(a['name'])}: {html.escape(str(a['parameters']))} (absorbed by "
+                  f"{html.escape(', '.join(a['absorbed_by']))})</li>" for a in dg.alternatives)
+    page = f"""<!doctype html><html><head><meta charset="utf-8"><title>hunting diagnosis</title></head><body>
+<h1>Diagnosis</h1>
+<p>Validation force-residual RMS: nominal {dg.nominal:.4g} N, extended {dg.extended:.4g} N.</p>
+<p>Criterion: {html.escape(dg.criterion)}.</p>
+<table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
+<th>validation RMS [N]</th></tr>{rows}</table>
+{'<h2>Alternatives</h2><ul>' + alt + '</ul>' if alt else ''}
+<img src="residual.png" width="720"></body></html>"""
+    (d / "index.html").write_text(page)
+    return d / "index.html"

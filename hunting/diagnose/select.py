@@ -1,0 +1,216 @@
+"""Which causes explain a model-data mismatch: forward selection on the force residual that does
+not fool itself.
+
+Criterion (stated in every report): a cause is added when (1) its extension, fitted by least
+squares on the fitting data, reduces the residual sum of squares there significantly (F test,
+p < alpha, with the degrees of freedom reduced to the effective number of independent samples
+n (1 - rho1) / (1 + rho1), rho1 the lag-1 autocorrelation of the extended model's residual,
+because smoothed residuals are far from white), and (2) it lowers the RMS residual on the validation data by at
+least ``min_gain`` (relative). Hyper-parameters (a cogging pitch, a Stribeck velocity) are chosen
+on the fitting data only. Causes are ranked by how much the validation RMS grows when each is
+dropped from the final extended model."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import stats
+
+from ..errors import SystemDefinitionError
+from .causes import CAUSES
+from .data import Measurement
+from .kinematics import Kinematics, kinematics, residual
+from .model import NominalModel
+
+CRITERION = ("F test on the fitting data (p < {alpha:g}, effective sample size from the residual's lag-1 "
+             "autocorrelation) and a validation RMS reduction of at least {min_gain:.0%}")
+
+
+@dataclass(frozen=True)
+class Cause:
+    """One reported cause: name; score (relative growth of the validation RMS when it is dropped
+    from the extended model); statistic (F) and p_value on the fitting data when it was added;
+    parameters and their standard uncertainties; gain: validation force-residual RMS [N] of the
+    model before and after adding it."""
+
+    name: str
+    score: float
+    statistic: float
+    p_value: float
+    parameters: dict
+    sigma: dict
+    gain: dict
+    hyper: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return dict(name=self.name, score=self.score, statistic=self.statistic, p_value=self.p_value,
+                    parameters=self.parameters, sigma=self.sigma, gain=self.gain)
+
+
+@dataclass
+class Diagnosis:
+    """causes : ranked list of Cause; nominal / extended : validation force-residual RMS [N];
+    criterion : the selection rule; kin_fit, kin_val : kinematics; r_* : residuals (n,) of the
+    nominal and extended model on both sets (NaN where not used: |v| small or filter edges);
+    rejected : candidates that failed the criterion at the step where selection stopped;
+    alternatives : causes that pass the criterion on their own but add nothing once the selected
+    ones are in (their stand-alone parameters: e.g. a constant offset that a direction-dependent
+    viscous term explains as well)."""
+
+    causes: list
+    nominal: float
+    extended: float
+    criterion: str
+    model: NominalModel
+    kin_fit: Kinematics
+    kin_val: Kinematics
+    r_fit_nominal: np.ndarray
+    r_val_nominal: np.ndarray
+    r_val_extended: np.ndarray
+    rejected: list = field(default_factory=list)
+    alternatives: list = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        return dict(causes=[c.as_dict() for c in self.causes],
+                    gain=dict(metric="force residual RMS [N] on the validation data", nominal=self.nominal,
+                              extended=self.extended),
+                    criterion=self.criterion, rejected=self.rejected, alternatives=self.alternatives,
+                    nominal_model=self.model.to_dict())
+
+
+def _rms(r) -> float:
+    return float(np.sqrt(np.mean(r ** 2)))
+
+
+def _n_eff(r: np.ndarray) -> float:
+    r = r - r.mean()
+    rho = float(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300))
+    rho = min(max(rho, 0.0), 0.999)
+    return r.size * (1 - rho) / (1 + rho)
+
+
+def _designs(name, kin_f, kin_v, model, mf, mv):
+    """(Phi_fit, Phi_val, hyper) per hyper-parameter variant of a cause, on the used samples."""
+    mod = CAUSES[name]
+    for hyper in mod.hypers(kin_f, model):
+        yield mod.design(kin_f, model, hyper)[mf], mod.design(kin_v, model, hyper)[mv], hyper
+
+
+def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
+             max_causes: int = 4, min_gain: float = 0.02, alpha: float = 1e-3, window: float | None = None) -> Diagnosis:
+    """Rank the causes of the mismatch between the model and the measured data.
+
+    fit : data to fit extensions on; validate : data to judge them on (default: the last 40 % of
+    ``fit``, the first 60 % being used for fitting); causes : names to consider (default all);
+    max_causes : bound on the selection; min_gain, alpha : the criterion (module docstring)."""
+    names = list(CAUSES) if causes is None else list(causes)
+    bad = [c for c in names if c not in CAUSES]
+    if bad:
+        raise SystemDefinitionError(f"causes {bad} are not known: use {sorted(CAUSES)}")
+    if validate is None:
+        t_split = fit.t[0] + 0.6 * (fit.t[-1] - fit.t[0])
+        fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
+    kf = kinematics(fit, model.cm, window=window)
+    kv = kinematics(validate, model.cm, window=window)
+    mf, mv = kf.moving, kv.moving
+    if mf.sum() < 50 or mv.sum() < 50:
+        raise SystemDefinitionError("too few moving samples (|v| > 2 % of the maximum) to diagnose the force balance")
+    rf0 = residual(kf, model)[mf]
+    rv0 = residual(kv, model)[mv]
+    chosen: list = []                      # (name, Phi_f, Phi_v, hyper, F, p, rms_before, rms_after)
+    Pf = np.zeros((rf0.size, 0))
+    Pv = np.zeros((rv0.size, 0))
+    rejected = []
+    alone: dict = {}                       # step-1 fits that pass the criterion on their own
+    crit = CRITERION.format(alpha=alpha, min_gain=min_gain)
+    for _ in range(max_causes):
+        th, *_ = np.linalg.lstsq(Pf, rf0, rcond=None) if Pf.shape[1] else (np.zeros(0),)
+        rf_cur = rf0 - Pf @ th
+        rv_cur = rv0 - Pv @ th
+        ss0 = float(rf_cur @ rf_cur)
+        best = None
+        for name in names:
+            if any(c[0] == name for c in chosen):
+                continue
+            fits = []
+            for df, dv, hyper in _designs(name, kf, kv, model, mf, mv):
+                A = np.column_stack([Pf, df])
+                t2, *_ = np.linalg.lstsq(A, rf0, rcond=None)
+                fits.append((float(np.sum((rf0 - A @ t2) ** 2)), df, dv, hyper, t2))
+            if not fits:
+                continue
+            # the simplest variant (first in the cause's list: e.g. the shortest cogging pitch, not
+            # a multiple of it) among those within 0.1 % of the best fit
+            ss_min = min(f[0] for f in fits)
+            ss1, df, dv, hyper, t2 = next(f for f in fits if f[0] <= ss_min * (1 + 1e-3))
+            k = df.shape[1]
+            # effective sample size from the residual of the extended fit (the residual before it
+            # is dominated by the very effect being tested, e.g. a smooth cogging force)
+            r1 = rf0 - np.column_stack([Pf, df]) @ t2
+            dof = max(_n_eff(r1) - Pf.shape[1] - k, 1.0)
+            F = ((ss0 - ss1) / k) / max(ss1 / dof, 1e-300)
+            p = float(stats.f.sf(F, k, dof))
+            rms_v = _rms(rv0 - np.column_stack([Pv, dv]) @ t2)
+            gain = 1 - rms_v / _rms(rv_cur)
+            row = (name, df, dv, hyper, float(F), p, _rms(rv_cur), rms_v, gain)
+            if p < alpha and gain >= min_gain:
+                if not chosen:
+                    alone[name] = (CAUSES[name].parameters(t2, hyper, model), gain)
+                if best is None or gain > best[-1]:
+                    best = row
+            else:
+                rejected.append(dict(name=name, step=len(chosen) + 1, F=float(F), p_value=p, validation_gain=gain))
+        if best is None:
+            break
+        chosen.append(best)
+        Pf = np.column_stack([Pf, best[1]])
+        Pv = np.column_stack([Pv, best[2]])
+        rejected = [r for r in rejected if r["step"] != len(chosen)]
+    # final joint fit: parameters, uncertainties, drop-one scores
+    result = []
+    rv_ext = rv0.copy()
+    if chosen:
+        th, *_ = np.linalg.lstsq(Pf, rf0, rcond=None)
+        r = rf0 - Pf @ th
+        # residual variance inflated by n / n_eff for the correlation of smoothed residuals
+        s2 = float(r @ r) / max(r.size - Pf.shape[1], 1.0) * (r.size / max(_n_eff(r), 1.0))
+        cov = np.linalg.pinv(Pf.T @ Pf) * s2
+        rv_ext = rv0 - Pv @ th
+        full = _rms(rv_ext)
+        col = 0
+        for (name, df, dv, hyper, F, p, before, after, gain) in chosen:
+            k = df.shape[1]
+            sl = slice(col, col + k)
+            col += k
+            keep = np.ones(Pf.shape[1], bool)
+            keep[sl] = False
+            if keep.any():
+                t_d, *_ = np.linalg.lstsq(Pf[:, keep], rf0, rcond=None)
+                dropped = _rms(rv0 - Pv[:, keep] @ t_d)
+            else:
+                dropped = _rms(rv0)
+            mod = CAUSES[name]
+            pars = mod.parameters(th[sl], hyper, model)
+            # uncertainties: propagate by finite differences through the parameter map
+            sig = {}
+            for key in pars:
+                grad = np.zeros(k)
+                for j in range(k):
+                    h = 1e-6 * max(1.0, abs(th[sl][j]))
+                    tp = th[sl].copy()
+                    tp[j] += h
+                    grad[j] = (mod.parameters(tp, hyper, model)[key] - pars[key]) / h
+                sig[key] = float(np.sqrt(max(grad @ cov[sl, sl] @ grad, 0.0)))
+            result.append(Cause(name, dropped / full - 1, F, p, pars, sig,
+                                dict(metric="force residual RMS [N], validation", nominal=before, extended=after), hyper))
+        result.sort(key=lambda c: -c.score)
+    rf_full = np.full(kf.t.size, np.nan)
+    rf_full[mf] = rf0
+    rvn = np.full(kv.t.size, np.nan)
+    rvn[mv] = rv0
+    rve = np.full(kv.t.size, np.nan)
+    rve[mv] = rv_ext
+    picked = {c.name for c in result}
+    alternatives = [dict(name=k, parameters=v[0], validation_gain=v[1], absorbed_by=sorted(picked))
+                    for k, v in alone.items() if k not in picked]
+    return Diagnosis(result, _rms(rv0), _rms(rv_ext), crit, model, kf, kv, rf_full, rvn, rve, rejected, alternatives)

@@ -1,0 +1,120 @@
+"""Diagnosis: hidden effects in synthetic data must be found blind, clean data must give no
+cause, and the EMPS benchmark's offset and asymmetry must come out beside the published values."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hunting.cli import main
+from hunting.diagnose import NominalModel, diagnose, fit_coulomb_viscous, kinematics, load, save_csv
+from hunting.diagnose.synthetic import TruePlant, generate
+from hunting.errors import SystemDefinitionError
+
+NOMINAL = {"plant": {"mass": 95.0, "motor_constant": 35.15},
+           "friction": {"law": "coulomb-viscous", "Fc": 20.0, "b": 200.0}}
+
+
+def _run(true, seeds=(1, 2)):
+    return diagnose(generate(true, seed=seeds[0]), NominalModel.from_dict(NOMINAL), generate(true, seed=seeds[1]))
+
+
+def test_clean_data_gives_no_cause():
+    dg = _run(TruePlant())
+    assert dg.causes == []
+    assert dg.extended == dg.nominal
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_hidden_offset_is_found_first(seed):
+    rng = np.random.default_rng(seed)
+    off = float(rng.choice([-1, 1]) * rng.uniform(1.5, 5.0))
+    dg = _run(TruePlant(offset=off), seeds=(seed, seed + 100))
+    assert dg.causes[0].name == "offset"
+    assert dg.causes[0].parameters["offset"] == pytest.approx(off, abs=0.05 * abs(off) + 0.05)
+    assert dg.extended < 0.5 * dg.nominal
+
+
+def test_hidden_asymmetry_is_found():
+    dg = _run(TruePlant(b_pos=170.0, b_neg=235.0))
+    c = dg.causes[0]
+    assert c.name == "asymmetry"
+    # the symmetric part stays the nominal 200 (true 202.5): b+- within 2 %
+    assert c.parameters["b_pos"] == pytest.approx(170.0, rel=0.02)
+    assert c.parameters["b_neg"] == pytest.approx(235.0, rel=0.02)
+
+
+def test_hidden_cogging_pitch_and_amplitude():
+    dg = _run(TruePlant(cog_amplitude=4.0, cog_pitch=0.012))
+    c = dg.causes[0]
+    assert c.name == "cogging"
+    assert c.parameters["pitch"] == pytest.approx(0.012, rel=0.01)
+    assert c.parameters["amplitude_1"] == pytest.approx(4.0, rel=0.05)
+    assert dg.extended < 0.3 * dg.nominal
+
+
+def test_two_hidden_effects_are_both_found():
+    dg = _run(TruePlant(offset=2.5, cog_amplitude=3.0, cog_pitch=0.02))
+    names = {c.name: c for c in dg.causes}
+    assert set(names) == {"offset", "cogging"}
+    assert names["offset"].parameters["offset"] == pytest.approx(2.5, abs=0.15)
+    assert names["cogging"].parameters["pitch"] == pytest.approx(0.02, rel=0.02)
+
+
+def test_emps_offset_and_asymmetry(shared_dir, tmp_path):
+    d = shared_dir / "data" / "emps"
+    if not (d / "DATA_EMPS.mat").is_file():
+        pytest.skip(f"EMPS data not found in {d}")
+    fit = load(d / "DATA_EMPS.mat")
+    # the pulses are already in vir (vir jumps by ~5 V at each pulse edge): not an extra force
+    val = load(d / "DATA_EMPS_PULSES.mat", names={"f_ext": None})
+    model, _ = fit_coulomb_viscous(kinematics(fit, 35.15065188))
+    assert model.mass == pytest.approx(95.1089, rel=0.05)
+    assert model.curve.positive.b == pytest.approx(203.5034, rel=0.02)
+    dg = diagnose(fit, model, val)
+    asym = next(c for c in dg.causes if c.name == "asymmetry")
+    assert asym.parameters["b_pos"] == pytest.approx(166.7061, rel=0.05)
+    assert asym.parameters["b_neg"] == pytest.approx(240.4236, rel=0.05)
+    off = [c.parameters["offset"] for c in dg.causes if c.name == "offset"] + \
+          [a["parameters"]["offset"] for a in dg.alternatives if a["name"] == "offset"]
+    assert off and off[0] == pytest.approx(-3.1648, abs=0.3)
+    assert dg.extended < 0.9 * dg.nominal
+
+
+def test_loaders_and_model_schema(tmp_path):
+    m = generate(TruePlant(), duration=2.0)
+    save_csv(m, tmp_path / "d.csv")
+    back = load(tmp_path / "d.csv")
+    assert np.allclose(back.q, m.q) and np.allclose(back.u, m.u) and np.allclose(back.q_ref, m.q_ref)
+    np.savez(tmp_path / "d.npz", t=m.t, qm=m.q, vir=m.u)
+    assert np.allclose(load(tmp_path / "d.npz").q, m.q)
+    (tmp_path / "bad.csv").write_text("t,q\n0,0\n")
+    with pytest.raises(SystemDefinitionError, match="no column for 'u'"):
+        load(tmp_path / "bad.csv")
+    (tmp_path / "d.txt").write_text("x")
+    with pytest.raises(SystemDefinitionError, match="suffix"):
+        load(tmp_path / "d.txt")
+    with pytest.raises(SystemDefinitionError, match="unknown keys"):
+        NominalModel.from_dict({"plant": {"mass": 1, "masss": 2}, "friction": {"Fc": 1}})
+    with pytest.raises(SystemDefinitionError, match="friction law"):
+        NominalModel.from_dict({"plant": {"mass": 1}, "friction": {"law": "magic", "Fc": 1}})
+    with pytest.raises(SystemDefinitionError, match="mass"):
+        NominalModel.from_dict({"plant": {"mass": -1}, "friction": {"Fc": 1}})
+    pm = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 60.0}})
+    assert pm.mass == 1.0 and pm.law == "switch"
+
+
+def test_cli_diagnose_writes_the_json_contract(tmp_path, capsys):
+    tp = TruePlant(offset=-3.0)
+    save_csv(generate(tp, seed=1), tmp_path / "fit.csv")
+    save_csv(generate(tp, seed=2), tmp_path / "val.csv")
+    (tmp_path / "model.json").write_text(json.dumps(NOMINAL))
+    rc = main(["diagnose", str(tmp_path / "fit.csv"), "--model", str(tmp_path / "model.json"), "--validate",
+               str(tmp_path / "val.csv"), "--json", str(tmp_path / "out.json"), "--report", str(tmp_path / "rep")])
+    assert rc == 0
+    out = json.loads((tmp_path / "out.json").read_text())
+    c = out["causes"][0]
+    assert c["name"] == "offset" and set(c) >= {"name", "score", "parameters", "gain"}
+    assert set(c["gain"]) >= {"metric", "nominal", "extended"} and c["gain"]["extended"] < c["gain"]["nominal"]
+    assert (tmp_path / "rep" / "index.html").is_file() and (tmp_path / "rep" / "residual.png").stat().st_size > 10_000
+    assert main(["diagnose", str(tmp_path / "nope.csv"), "--model", str(tmp_path / "model.json")]) == 2
