@@ -17,6 +17,14 @@ def save(fig, path) -> None:
     _plt().close(fig)
 
 
+def _axes(ax, figsize):
+    """(fig, ax, own): a new figure when ax is None (own = True), else the axes' figure."""
+    if ax is None:
+        fig, ax = _plt().subplots(figsize=figsize)
+        return fig, ax, True
+    return ax.figure, ax, False
+
+
 def _finish(fig, ax, own: bool, title: str, path) -> None:
     """Common tail of the single-axes plots: title, layout and saving when the figure is ours."""
     if title:
@@ -94,12 +102,7 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
                    path=None, unit: str = "m"):
     """P^k(d) against d with the diagonal; optional cobweb from ``cobweb_from`` (iterating the
     true map) and fixed points (stable filled, unstable open)."""
-    plt = _plt()
-    own = ax is None
-    if own:
-        fig, ax = plt.subplots(figsize=(5.6, 5.0))
-    else:
-        fig = ax.figure
+    fig, ax, own = _axes(ax, (5.6, 5.0))
     k = em.iterate
     lab = "P(d)" if k == 1 else f"P$^{k}$(d)"
     ax.plot(em.grid, em.image, ".", ms=2.0, color="C0", label=lab)
@@ -136,12 +139,7 @@ def plot_map_diagram(diagram, *, title: str = "", ax=None, path=None, unit: str 
     """Bifurcation diagram from event maps: cycle stick errors against the parameter, stable
     solid and unstable dashed; the equilibrium set (d = 0) solid where stable, dashed where not;
     folds and stability changes marked."""
-    plt = _plt()
-    own = ax is None
-    if own:
-        fig, ax = plt.subplots(figsize=(6.0, 4.2))
-    else:
-        fig = ax.figure
+    fig, ax, own = _axes(ax, (6.0, 4.2))
     v = diagram.values
     # cycles: connect points branch by branch (sorted by d within each parameter value)
     branches: dict = {}
@@ -297,16 +295,10 @@ def plot_attractor_diagram(values, attractors_per_value, *, param: str = "K", ti
     period, as in thesis Fig. 10.12); squares at 0 where the equilibrium set attracts. Entries of
     ``attractors_per_value`` are lists of objects with ``kind`` ("cycle", "equilibrium",
     "irregular") and ``d`` (stick errors)."""
-    plt = _plt()
-    own = ax is None
-    if own:
-        fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    else:
-        fig = ax.figure
+    fig, ax, own = _axes(ax, (6.4, 4.4))
     labelled = set()
     for v, atts in zip(values, attractors_per_value):
         for a in atts:
-            lab = None
             if a.kind == "equilibrium":
                 lab = "equilibrium set attracts" if "eq" not in labelled else None
                 labelled.add("eq")

@@ -1,7 +1,6 @@
 """Diagnosis: hidden effects in synthetic data must be found blind, clean data must give no
 cause, and the EMPS benchmark's offset and asymmetry must come out beside the published values."""
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest

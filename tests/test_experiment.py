@@ -117,3 +117,20 @@ def test_bad_input_is_named():
         DiscretePID(1.0, 0.0, 0.0, tau_f=-1.0)
     with pytest.raises(SystemDefinitionError, match="model"):
         L.IdentifiedLiMMS(74.4, None, {}, None, None, 0.0).loop(10.0, model="coulomb")
+
+
+def test_discrete_pid_frf_is_the_law_the_simulator_runs():
+    """DiscretePID.frf against the numba loop itself: a motor too heavy to move, a sinusoidal
+    reference, and the recorded feedback u_c = -C(e) read at the excitation frequency."""
+    m = replace(VirtualMotor(), mass=1e15, resolution=0.0, noise=0.0)
+    pid = DiscretePID(kp=8.2e3, kd=53.0, ki=3.8e5, tau_f=4.3e-4)
+    n, f0 = 50_000, 37.0                                  # 10 s, 370 whole periods
+    t = np.arange(n) / m.fs
+    r = 1e-5 * np.sin(2 * np.pi * f0 * t)
+    rec = run(m, pid, n, reference=r, x0=(0.0, 0.0, 0.0), u_max=1e9)
+    e = rec.y - r
+    sel = slice(n // 2, n)                              # after the integrator's start-up
+    ph = np.exp(-2j * np.pi * f0 * t[sel])
+    C_meas = np.sum(-rec.uc[sel] * ph) / np.sum(e[sel] * ph)
+    C = pid.frf(np.array([f0]), m.fs)[0]
+    assert abs(C_meas / C - 1) < 1e-3, (C_meas, C)

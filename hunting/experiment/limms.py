@@ -6,12 +6,12 @@ strong PID (cross-over ~74 Hz, like the thesis' tuned controller) for tracking, 
 fixed-shape regulator PID u = -K[2 e + e'/(2 pi) + 2 pi int e] at q_d = -0.38 m."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
-from ..errors import SystemDefinitionError, check_finite_positive
+from ..errors import SystemDefinitionError
 from ..identify import (cogging_table, curve_from_fit, estimate_frf, fit_double_integrator, fit_second_order,
                         fit_stribeck)
 from ..identify.frf import FRF, ParameterFit, prbs
@@ -204,7 +204,6 @@ def stick_phases(rec: Record, resolution: float, *, window: float = 0.03, counts
     n = y.size
     if n < w:
         return []
-    from numpy.lib.stride_tricks import sliding_window_view
     win = sliding_window_view(y, w)
     still = (win.max(axis=1) - win.min(axis=1)) <= tol
     phases, k = [], 0
@@ -218,8 +217,6 @@ def stick_phases(rec: Record, resolution: float, *, window: float = 0.03, counts
             last_ref = y[j + w - 1]
             k = j + w
         else:
-            if not still[k]:
-                pass
             k += 1
     return phases
 
@@ -348,16 +345,12 @@ def measured_attractor(motor: VirtualMotor, K: float, d0: float, *, t_settle: fl
     the equilibrium set, quantization and the integral action still cause micro-slips of a few
     tens of um now and then)."""
     rec = regulator_experiment(motor, K, d0, t_settle + t_record, seed=seed, hold=False)
-    n0 = int(t_settle * motor.fs)
-    e = rec.y - Q_D
-    tail = Record(rec.t[n0:], rec.y[n0:], rec.u[n0:], rec.uc[n0:], rec.r[n0:], rec.v[n0:], rec.q[n0:],
-                  rec.qd[n0:], rec.z[n0:], rec.state, rec.ctrl_state)
-    amp = float(np.max(np.abs(e[n0:])))
-    half = n0 + (e.size - n0) // 2
-    ph = stick_phases(tail, motor.resolution)
-    if np.max(np.abs(e[half:])) < rest:
+    tail = rec.since(int(t_settle * motor.fs))
+    e = tail.y - Q_D
+    amp = float(np.max(np.abs(e)))
+    if np.max(np.abs(e[e.size // 2:])) < rest:
         return MeasuredAttractor(K, 0, np.zeros(0), True, 0, amp)
-    d = np.array([tail.y[a] - Q_D for a, _ in ph])
+    d = np.array([e[a] for a, _ in stick_phases(tail, motor.resolution)])
     period = 0
     for p in range(1, min(32, d.size // 2) + 1):
         if np.all(np.abs(d[p:] - d[:-p]) <= tol):

@@ -9,7 +9,7 @@ u_k = sat(-(kp e_k + kd D_k + ki I_k) + v_k + ff_k), held over [t_k, t_k + T).""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
@@ -129,10 +129,10 @@ class Record:
     ok: bool = True
     message: str = ""
 
-    @property
-    def force(self) -> np.ndarray:
-        """Feedback force cm uc is not stored: use ``motor.cm * rec.uc``."""
-        raise AttributeError("use motor.cm * record.uc")
+    def since(self, k: int) -> "Record":
+        """The samples from index k on (final states unchanged)."""
+        cut = {name: getattr(self, name)[k:] for name in ("t", "y", "u", "uc", "r", "v", "q", "qd", "z")}
+        return replace(self, **cut)
 
 
 def _as_samples(name, val, n):
