@@ -3,7 +3,8 @@
 Positions are differentiated with a Savitzky-Golay filter (local cubic least squares over
 ``window`` seconds, zero phase); the drive force cm u + f_ext goes through the same smoothing
 (parallel filtering, as in inverse-dynamics identification) so both sides of the force balance
-have the same bandwidth; u is aligned for the zero-order hold of a digital controller. The residual of a model is r = force - m a - F(v) - offset."""
+have the same bandwidth; u is aligned for the zero-order hold of a digital controller. The residual of a model is r = force - m a - F(v) - offset - F_cog(q)
+(and the first-order delay term)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -55,5 +56,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
 
 
 def residual(kin: Kinematics, model) -> np.ndarray:
-    """Force residual r = force - m a - F(v) - offset [N] of a NominalModel."""
-    return kin.force - model.mass * kin.a - model.friction(kin.v) - model.offset
+    """Force residual r = force - delay cm u' - m a - F(v) - offset - F_cog(q) [N] of a
+    NominalModel (the delay to first order: cm u(t - delay) ~ cm u(t) - delay cm u'(t))."""
+    return (kin.force - model.delay * kin.cm * kin.du - model.mass * kin.a - model.friction(kin.v) - model.offset
+            - model.cogging_force(kin.q))

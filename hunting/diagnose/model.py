@@ -5,7 +5,9 @@ residual needs.
 Schema (keys beyond these are errors, so typos are caught):
 
     {"preset": "table9.1", "set": {"P": 60.0}}
-    {"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 0.0},
+    {"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 0.0, "delay": 0.0,
+               "cogging": [{"pitch": 0.02, "cos": [..], "sin": [..]}, ...],      # harmonics k = 1, 2..
+               "cogging_table": [{"q": [..], "F": [..]}, ...]},                 # linear interpolation
      "friction": {"law": "coulomb-viscous" | "stribeck" | "switch" | "lugre",
                   "Fc": .., "Fs": .., "vs": .., "beta": .., "b": .., "sigma0": .., "sigma1": ..,
                   "sigma2": (alias of b), "Fc_neg": .., ... (direction-dependent values)},
@@ -21,11 +23,12 @@ import numpy as np
 
 from ..errors import SystemDefinitionError, check_finite, check_finite_positive
 from ..models.friction import DirectionalCurve, LuGre, StribeckCurve
+from ..models.plant import COG_TABLE, Cogging
 
 LAWS = ("coulomb-viscous", "stribeck", "switch", "lugre")
 _FRICTION_KEYS = {"law", "Fc", "Fs", "vs", "beta", "b", "sigma0", "sigma1", "sigma2",
                   "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg"}
-_PLANT_KEYS = {"mass", "motor_constant", "offset"}
+_PLANT_KEYS = {"mass", "motor_constant", "offset", "delay", "cogging", "cogging_table"}
 _CONTROLLER_TYPES = ("pid", "pd-velocity-loop")
 
 
@@ -34,7 +37,10 @@ class NominalModel:
     """mass [kg or kg m^2]; cm : motor constant [N/V] (1 if u is a force); curve : the static
     friction-velocity map (per direction); law : its name; offset [N] : constant force (plant
     equation m q'' = cm u + f_ext - F(q') - offset); sigma0, sigma1 : LuGre parameters when the
-    law is lugre; controller : the controller description (dict), or None; source : the dict."""
+    law is lugre; controller : the controller description (dict), or None; source : the dict.
+    cogging : tuple of :class:`hunting.models.plant.Cogging` components (harmonic or table),
+    summed; delay [s] : actuation delay (the plant
+    receives cm u(t - delay)). All forces act like friction: m q'' = cm u - F(q') - offset - F_cog(q)."""
 
     mass: float
     cm: float
@@ -45,11 +51,20 @@ class NominalModel:
     sigma1: float | None = None
     controller: dict | None = None
     source: dict = field(default_factory=dict)
+    cogging: tuple = ()
+    delay: float = 0.0
 
     def __post_init__(self):
         check_finite_positive("mass", self.mass)
         check_finite_positive("motor_constant", self.cm)
         check_finite("offset", self.offset)
+        check_finite_positive("delay", self.delay, allow_zero=True)
+        if not all(isinstance(c, Cogging) for c in self.cogging):
+            raise SystemDefinitionError(f"cogging = {self.cogging!r} must be a tuple of Cogging components")
+        object.__setattr__(self, "cogging", tuple(self.cogging))
+        if self.law == "lugre":
+            check_finite_positive("sigma0", self.sigma0)
+            check_finite_positive("sigma1", self.sigma1, allow_zero=True)
         if self.law not in LAWS:
             raise SystemDefinitionError(f"friction law = {self.law!r} is not allowed: use one of {LAWS}")
 
@@ -63,6 +78,27 @@ class NominalModel:
         out[n] = -neg.level(-v[n]) + neg.b * v[n]
         return out
 
+    def cogging_force(self, q) -> np.ndarray:
+        """F_cog(q) [N]: the sum of the components (0 without cogging)."""
+        q = np.asarray(q, dtype=float)
+        out = np.zeros_like(q)
+        for c in self.cogging:
+            d = np.asarray(c.data)
+            if c.kind == COG_TABLE:
+                out += np.interp(q, d[:c.n], d[c.n:])
+                continue
+            for k in range(c.n):
+                w = 2 * np.pi * (k + 1) / c.period
+                out += d[2 * k] * np.cos(w * q) + d[2 * k + 1] * np.sin(w * q)
+        return out
+
+    def replace(self, **changes) -> "NominalModel":
+        """A copy with fields changed (an extended model); ``source`` is rebuilt from it."""
+        from dataclasses import replace
+        new = replace(self, **changes)
+        object.__setattr__(new, "source", new.to_dict())
+        return new
+
     def to_dict(self) -> dict:
         c = self.curve
         fr = {"law": self.law, "Fc": c.positive.Fc, "Fs": c.positive.Fs, "vs": c.positive.vs,
@@ -72,7 +108,16 @@ class NominalModel:
                       beta_neg=c.negative.beta, b_neg=c.negative.b)
         if self.law == "lugre":
             fr.update(sigma0=self.sigma0, sigma1=self.sigma1)
-        d = {"plant": {"mass": self.mass, "motor_constant": self.cm, "offset": self.offset}, "friction": fr}
+        plant = {"mass": self.mass, "motor_constant": self.cm, "offset": self.offset}
+        if self.delay:
+            plant["delay"] = self.delay
+        harm = [c for c in self.cogging if c.kind != COG_TABLE]
+        tabs = [c for c in self.cogging if c.kind == COG_TABLE]
+        if harm:
+            plant["cogging"] = [{"pitch": c.period, "cos": list(c.data[0::2]), "sin": list(c.data[1::2])} for c in harm]
+        if tabs:
+            plant["cogging_table"] = [{"q": list(c.data[:c.n]), "F": list(c.data[c.n:])} for c in tabs]
+        d = {"plant": plant, "friction": fr}
         if self.controller is not None:
             d["controller"] = self.controller
         return d
@@ -142,7 +187,22 @@ class NominalModel:
             raise SystemDefinitionError("model friction: lugre needs 'sigma0' and 'sigma1'")
         return NominalModel(float(pl["mass"]), float(pl.get("motor_constant", 1.0)), DirectionalCurve(pos, neg), law,
                             offset=float(pl.get("offset", 0.0)), sigma0=fr.get("sigma0"), sigma1=fr.get("sigma1"),
-                            controller=ctrl, source=d)
+                            controller=ctrl, source=d, cogging=_cogging(pl.get("cogging", []), pl.get("cogging_table", [])), delay=float(pl.get("delay", 0.0)))
+
+
+def _cogging(harmonics, tables) -> tuple:
+    """Cogging components from the schema: harmonics [{"pitch", "cos", "sin"}], tables
+    [{"q", "F"}] (a single object is accepted for either)."""
+    out = []
+    for it in [harmonics] if isinstance(harmonics, dict) else harmonics:
+        if not (isinstance(it, dict) and set(it) == {"pitch", "cos", "sin"}):
+            raise SystemDefinitionError(f"plant cogging entry {it!r} must be {{'pitch': p, 'cos': [..], 'sin': [..]}}")
+        out.append(Cogging.harmonic(it["pitch"], it["cos"], it["sin"]))
+    for it in [tables] if isinstance(tables, dict) else tables:
+        if not (isinstance(it, dict) and set(it) == {"q", "F"}):
+            raise SystemDefinitionError(f"plant cogging_table entry {it!r} must be {{'q': [..], 'F': [..]}}")
+        out.append(Cogging.table(it["q"], it["F"]))
+    return tuple(out)
 
 
 def fit_coulomb_viscous(kin, *, v_min_frac: float = 0.02) -> tuple[NominalModel, dict]:

@@ -1,19 +1,23 @@
 """Synthetic "measured" data with hidden effects, for tests that call the diagnosis blind.
 
 The true plant: m q'' = cm u(t - delay) + f_ext - F(q') - offset - F_cog(q), with Coulomb +
-viscous friction per direction (Fc+-, b+-; Coulomb regularized over 1e-4 m/s, far below the
-speeds used), F_cog = A sin(2 pi q / pitch); a 1 kHz PD position-velocity loop like the EMPS
-benchmark (u = kv (kp (q_ref - q) - v_f), v_f a backward difference of a 2-tap averaged
-position, saturation at 10 V) tracks bang-bang strokes; the encoder quantizes q."""
+viscous friction per direction (Fc+-, b+-; exact stick), F_cog = A sin(2 pi q / pitch), a
+random force disturbance; a 1 kHz PD position-velocity loop like the EMPS benchmark
+(u = kv (kp (q_ref - q) - v_f), v_f a backward difference of a 2-tap averaged position,
+saturation at 10 V) tracks bang-bang strokes; the encoder quantizes q. The loop is simulated by
+:func:`hunting.diagnose.resimulate.resimulate` (the same sampled-loop engine as the behaviour view).
+"""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
-import numba
 import numpy as np
 
+from ..models.friction import DirectionalCurve, StribeckCurve
+from ..models.plant import Cogging
 from .data import Measurement
+from .model import NominalModel
+from .resimulate import resimulate
 
 
 @dataclass(frozen=True)
@@ -36,46 +40,6 @@ class TruePlant:
     resolution: float = 1e-6
     force_noise: float = 0.5
     extra: dict = field(default_factory=dict)
-
-
-@numba.njit(cache=True)
-def _accel(q, v, ua, f_noise, par):
-    m, cm, fcp, fcn, bp, bn, off, ca, cp = par[0], par[1], par[2], par[3], par[4], par[5], par[6], par[7], par[8]
-    fc = fcp if v >= 0 else fcn
-    b = bp if v >= 0 else bn
-    F = fc * math.tanh(v / 1e-4) + b * v + off + ca * math.sin(2 * math.pi * q / cp) - f_noise
-    return (cm * ua - F) / m
-
-
-@numba.njit(cache=True)
-def _simulate(par, r, noise, n_delay, sub, out_q, out_u):
-    kp, kv, dt, res = par[9], par[10], par[11], par[12]
-    q, v = r[0], 0.0
-    u_hist = np.zeros(n_delay + 1)
-    qf_prev = q
-    y_prev = q
-    h = dt / sub
-    for k in range(r.size):
-        y = res * math.floor(q / res + 0.5) if res > 0 else q
-        qf = 0.5 * y + 0.5 * y_prev
-        vf = (qf - qf_prev) / dt
-        qf_prev = qf
-        y_prev = y
-        u = kv * (kp * (r[k] - y) - vf)
-        u = min(max(u, -10.0), 10.0)
-        out_q[k] = y
-        out_u[k] = u
-        for j in range(n_delay, 0, -1):
-            u_hist[j] = u_hist[j - 1]
-        u_hist[0] = u
-        ua = u_hist[n_delay]
-        for _ in range(sub):                      # midpoint rule
-            a1 = _accel(q, v, ua, noise[k], par)
-            qm = q + 0.5 * h * v
-            vm = v + 0.5 * h * a1
-            a2 = _accel(qm, vm, ua, noise[k], par)
-            q += h * vm
-            v += h * a2
 
 
 def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0) -> np.ndarray:
@@ -105,14 +69,21 @@ def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0) ->
     return r
 
 
+def true_model(true: TruePlant) -> NominalModel:
+    """The true plant and its controller as a NominalModel (what a perfect diagnosis recovers)."""
+    curve = DirectionalCurve(StribeckCurve(true.Fc_pos, true.Fc_pos, b=true.b_pos),
+                             StribeckCurve(true.Fc_neg, true.Fc_neg, b=true.b_neg))
+    cog = (Cogging.sine(true.cog_amplitude, true.cog_pitch),) if true.cog_amplitude else ()
+    ctrl = {"type": "pd-velocity-loop", "kp": true.kp, "kv": true.kv, "sample_time": 1.0 / true.fs, "saturation": 10.0}
+    return NominalModel(true.mass, true.cm, curve, "coulomb-viscous", offset=true.offset, controller=ctrl,
+                        cogging=cog, delay=true.delay)
+
+
 def generate(true: TruePlant, duration: float = 20.0, seed: int = 0, substeps: int = 10) -> Measurement:
     """A run of the true plant tracking bang-bang strokes; q quantized, u recorded."""
     r = bang_bang(true.fs, duration, seed=seed)
-    rng = np.random.default_rng(seed + 1)
-    noise = rng.normal(0.0, true.force_noise, r.size)
-    par = np.array([true.mass, true.cm, true.Fc_pos, true.Fc_neg, true.b_pos, true.b_neg, true.offset,
-                    true.cog_amplitude, true.cog_pitch, true.kp, true.kv, 1.0 / true.fs, true.resolution])
-    q, u = np.empty(r.size), np.empty(r.size)
-    _simulate(par, r, noise, int(round(true.delay * true.fs)), substeps, q, u)
+    noise = np.random.default_rng(seed + 1).normal(0.0, true.force_noise, r.size)
     t = np.arange(r.size) / true.fs
-    return Measurement(t, q, u, q_ref=r, name=f"synthetic(seed={seed})")
+    template = Measurement(t, np.full(r.size, r[0]), np.zeros(r.size), q_ref=r, name=f"synthetic(seed={seed})")
+    sim = resimulate(template, true_model(true), substeps=substeps, resolution=true.resolution, force_noise=noise)
+    return Measurement(t, sim.q, sim.u, q_ref=r, name=f"synthetic(seed={seed})")

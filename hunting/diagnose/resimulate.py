@@ -1,0 +1,313 @@
+"""Re-simulation of the closed loop from the measured reference: the behaviour view of a diagnosis.
+
+The model (a :class:`NominalModel`, nominal or extended) is driven by the digital controller of
+its ``controller`` description, sampled at the data's instants, with a zero-order hold, the
+encoder resolution of the data and the controller's saturation:
+
+    m q'' = cm u(t - delay) + f_ext - F - offset - F_cog(q)
+
+Friction F: for the static laws (coulomb-viscous, stribeck, switch) the exact stick of the Switch
+model in its Filippov limit (the mass sticks when its velocity reaches zero and the force it
+needs, |cm u + f_ext - offset - F_cog| <= Fs of that direction, is available; it slips again when
+not); reversals are located inside a substep by linear interpolation of v. For lugre the bristle
+state z is integrated (F = sigma0 z + sigma1 z' + b v). The plant is integrated with fixed RK4
+substeps between samples (``substeps`` per sample).
+
+Controllers (the MODEL.json ``controller`` schema):
+  {"type": "pid", "form": "PDI", "P", "D", "I"}  u = -P (e + D e' + I int e), e = q - q_ref
+  {"type": "pid", "form": "K", "K", "tau_d", "tau_i"}  the fixed shape of chapters 8 and 10
+  {"type": "pid", "kp", "kd", "ki"}                     plain gains
+  common pid keys: "derivative_on": "error" | "measurement", "tau_f" [s] (first-order filter of
+  the difference quotient), "sample_time" [s], "saturation" (|u| bound, default none);
+  {"type": "pd-velocity-loop", "kp" [1/s], "kv", "sample_time", "saturation"}:
+  u = kv (kp (q_ref - q) - v_f), v_f the backward difference of the 2-tap averaged position
+  (the EMPS benchmark's controller).
+The integral state starts where the first controller output equals the measured u[0]."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from ..errors import SystemDefinitionError, check_finite, check_finite_positive
+from ..models.controller import PID
+from ..models.friction import lugre_rates, stribeck_level
+from ..models.plant import cogging_force
+from .data import Measurement
+from .model import NominalModel
+
+_PID, _PDV = 1.0, 2.0
+_CTRL_KEYS = {"pid": {"type", "form", "P", "D", "I", "K", "tau_d", "tau_i", "kp", "kd", "ki", "derivative_on",
+                      "tau_f", "sample_time", "saturation"},
+              "pd-velocity-loop": {"type", "kp", "kv", "sample_time", "saturation"}}
+
+
+@dataclass(frozen=True)
+class SampledController:
+    """A digital controller from the schema: kind "pid" or "pd-velocity-loop"; kp, kd, ki [u/m,
+    u s/m, u/(m s)] for pid (kp [1/s] and kv [u s/m] for the velocity loop); tau_f [s];
+    derivative_on_measurement; sample_time [s] or None (the data's); saturation (|u| bound, inf
+    for none)."""
+
+    kind: str
+    kp: float
+    kd: float = 0.0
+    ki: float = 0.0
+    kv: float = 0.0
+    tau_f: float = 0.0
+    derivative_on_measurement: bool = False
+    sample_time: float | None = None
+    saturation: float = math.inf
+
+    @staticmethod
+    def from_schema(d: dict) -> "SampledController":
+        if not isinstance(d, dict) or d.get("type") not in _CTRL_KEYS:
+            raise SystemDefinitionError(f"controller = {d!r}: 'type' must be one of {sorted(_CTRL_KEYS)}")
+        kind = d["type"]
+        bad = set(d) - _CTRL_KEYS[kind]
+        if bad:
+            raise SystemDefinitionError(f"controller ({kind}): unknown keys {sorted(bad)}; allowed: "
+                                        f"{sorted(_CTRL_KEYS[kind])}")
+        ts = d.get("sample_time")
+        ts = None if ts is None else check_finite_positive("controller sample_time", ts)
+        sat = check_finite_positive("controller saturation", d.get("saturation", math.inf), allow_inf=True)
+        if kind == "pd-velocity-loop":
+            for k in ("kp", "kv"):
+                if k not in d:
+                    raise SystemDefinitionError(f"controller (pd-velocity-loop): {k!r} is required")
+            return SampledController(kind, check_finite("kp", d["kp"]), kv=check_finite("kv", d["kv"]),
+                                     sample_time=ts, saturation=sat)
+        form = d.get("form", "gains")
+        if form == "PDI":
+            pid = PID.pdi(d.get("P", 0.0), d.get("D", 0.0), d.get("I", 0.0))
+        elif form == "K":
+            pid = PID.fixed_shape(d["K"], d.get("tau_d", 1 / (2 * math.pi)), d.get("tau_i", 1 / (2 * math.pi)))
+        elif form == "gains":
+            pid = PID(check_finite("kp", d.get("kp", 0.0)), check_finite("kd", d.get("kd", 0.0)),
+                      check_finite("ki", d.get("ki", 0.0)))
+        else:
+            raise SystemDefinitionError(f"controller form = {form!r} is not allowed: use 'PDI', 'K' or 'gains'")
+        on = d.get("derivative_on", "error")
+        if on not in ("error", "measurement"):
+            raise SystemDefinitionError(f"controller derivative_on = {on!r}: use 'error' or 'measurement'")
+        tau_f = check_finite_positive("controller tau_f", d.get("tau_f", 0.0), allow_zero=True)
+        return SampledController("pid", pid.kp, pid.kd, pid.ki, 0.0, tau_f, on == "measurement", ts, sat)
+
+    def array(self, dt: float) -> np.ndarray:
+        """[kind code, kp, kd, ki, kv, tau_f, d_on_meas, saturation, hold] for the kernel; hold =
+        data samples per controller update (sample_time / dt, an integer)."""
+        hold = 1
+        if self.sample_time is not None:
+            hold = int(round(self.sample_time / dt))
+            if hold < 1 or abs(hold * dt - self.sample_time) > 1e-6 * self.sample_time:
+                raise SystemDefinitionError(
+                    f"controller sample_time = {self.sample_time!r} s is not an integer multiple of the data's "
+                    f"sample interval {dt!r} s: resample the data or correct sample_time")
+        code = _PID if self.kind == "pid" else _PDV
+        return np.array([code, self.kp, self.kd, self.ki, self.kv, self.tau_f, float(self.derivative_on_measurement),
+                         self.saturation, float(hold)])
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _cog(q, cog, bases):
+    out = 0.0
+    for b in bases:
+        out += cogging_force(q, cog, b)
+    return out
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _rates(q, v, z, s, fa, p, cog, bases):
+    """(q', v', z') at applied force fa (cm u + f_ext - offset), direction s for the curve."""
+    base = 4 if s > 0 else 9
+    fd = fa - _cog(q, cog, bases)
+    if p[3] > 0.5:
+        zd, F = lugre_rates(v, z, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4], p[14], p[15], 0.0)
+        return v, (fd - F) / p[0], zd
+    F = s * stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3]) + p[base + 4] * v
+    return v, (fd - F) / p[0], 0.0
+
+
+@numba.njit(cache=True, error_model="numpy", nogil=True)
+def _loop(p, cog, bases, ctrl, r, fext, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
+          v_out, stuck_out):
+    """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev] (updated in
+    place). Returns the number of samples done (< r.size when the state stopped being finite)."""
+    h = dt / substeps
+    lugre = p[3] > 0.5
+    hold = int(ctrl[8])
+    u = u_init
+    q, v, z, stuck = x[0], x[1], x[2], x[3] > 0.5
+    for k in range(r.size):
+        y = resolution * math.floor(q / resolution + 0.5) if resolution > 0.0 else q
+        if k % hold == 0:
+            T = dt * hold
+            if ctrl[0] == 1.0:
+                e = y - r[k]
+                sig = y if ctrl[6] > 0.5 else e
+                x[4] += T * e
+                x[5] = (ctrl[5] * x[5] + (sig - x[6])) / (ctrl[5] + T)
+                x[6] = sig
+                u = -(ctrl[1] * e + ctrl[2] * x[5] + ctrl[3] * x[4])
+            else:
+                qf = 0.5 * y + 0.5 * x[7]
+                u = ctrl[4] * (ctrl[1] * (r[k] - y) - (qf - x[8]) / T)
+                x[8] = qf
+            x[7] = y
+            if u > ctrl[7]:
+                u = ctrl[7]
+            elif u < -ctrl[7]:
+                u = -ctrl[7]
+        q_out[k] = y
+        u_out[k] = u
+        v_out[k] = v
+        stuck_out[k] = stuck
+        for i in range(substeps):
+            j = (k * substeps + i - delay_sub)
+            ua = u_init if j < 0 else u_out[j // substeps]
+            fa = p[1] * ua + fext[k] - p[2]
+            if lugre:
+                s = 1.0 if v >= 0.0 else -1.0
+                a1, b1, c1 = _rates(q, v, z, s, fa, p, cog, bases)
+                a2, b2, c2 = _rates(q + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, s, fa, p, cog, bases)
+                a3, b3, c3 = _rates(q + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, s, fa, p, cog, bases)
+                a4, b4, c4 = _rates(q + h * a3, v + h * b3, z + h * c3, s, fa, p, cog, bases)
+                q += h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+                v += h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+                z += h / 6.0 * (c1 + 2 * c2 + 2 * c3 + c4)
+                continue
+            rem = h
+            for _ in range(3):             # a substep holds at most a stop and a restart
+                if stuck:
+                    need = fa - _cog(q, cog, bases)
+                    if -p[10] <= need <= p[5]:
+                        break              # friction holds the mass
+                    stuck = False
+                    s = 1.0 if need > 0.0 else -1.0
+                else:
+                    s = 1.0 if v > 0.0 else -1.0
+                a1, b1, _ = _rates(q, v, 0.0, s, fa, p, cog, bases)
+                a2, b2, _ = _rates(q + 0.5 * rem * a1, v + 0.5 * rem * b1, 0.0, s, fa, p, cog, bases)
+                a3, b3, _ = _rates(q + 0.5 * rem * a2, v + 0.5 * rem * b2, 0.0, s, fa, p, cog, bases)
+                a4, b4, _ = _rates(q + rem * a3, v + rem * b3, 0.0, s, fa, p, cog, bases)
+                qn = q + rem / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+                vn = v + rem / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+                if s * vn > 0.0:
+                    q, v = qn, vn
+                    break
+                # the velocity reaches zero inside: stop there (v linear in time), then decide
+                # stick or slip for the rest of the substep
+                th = s * v / (s * v - s * vn) if s * v - s * vn > 0.0 else 1.0
+                q = q + th * (qn - q)
+                v = 0.0
+                stuck = True
+                rem *= 1.0 - th
+                if rem <= 0.0:
+                    break
+        if not (math.isfinite(q) and math.isfinite(v) and math.isfinite(z)):
+            return k
+    x[0], x[1], x[2], x[3] = q, v, z, 1.0 if stuck else 0.0
+    return r.size
+
+
+def model_arrays(model: NominalModel):
+    """(p, cog, bases): the flat parameter vector and the cogging components' encodings
+    (concatenated; component i starts at bases[i]) of a NominalModel, as the kernel reads them."""
+    law = 1.0 if model.law == "lugre" else 0.0
+    p = np.array([model.mass, model.cm, model.offset, law, *model.curve.positive.encoded(),
+                  *model.curve.negative.encoded(), model.sigma0 or 0.0, model.sigma1 or 0.0])
+    blocks = [c.encoded() for c in model.cogging] or [np.zeros(3)]
+    bases = np.cumsum([0] + [b.size for b in blocks[:-1]]).astype(np.int64)
+    if not model.cogging:
+        bases = np.zeros(0, np.int64)
+    return p, np.concatenate(blocks), bases
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """A re-simulated run on the measurement's instants: t [s], q (quantized like the data) [m],
+    u (controller output), v [m/s], stuck (bool, static laws only); ok/message as in the
+    integrators (the state stopped being finite)."""
+
+    t: np.ndarray
+    q: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    stuck: np.ndarray
+    ok: bool = True
+    message: str = ""
+
+
+def resolution_of(q: np.ndarray) -> float:
+    """Encoder resolution [m] read from quantized positions: the smallest nonzero step that
+    occurs often (0 when the positions do not look quantized)."""
+    d = np.abs(np.diff(q))
+    d = d[d > 1e-15]
+    if d.size < 10:
+        return 0.0
+    step = float(np.percentile(d, 1))
+    counts = d / step
+    if np.mean(np.abs(counts - np.round(counts)) < 0.02) > 0.95:
+        return step
+    return 0.0
+
+
+def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | None = None,
+               substeps: int = 20, resolution: float | None = None, force_noise=None, x0=None) -> Simulation:
+    """Re-simulate the closed loop of ``model`` on the instants of ``meas``, tracking its q_ref,
+    with its f_ext, from its initial position (at rest when the measured speed is below one count
+    per sample). controller : the schema dict (default: the model's); resolution [m] : encoder
+    quantization (default: read from the data); force_noise : optional (n,) force [N] added to the
+    drive (for synthetic data); x0 : (q [m], v [m/s], z [m]) to start from instead (z: LuGre's
+    bristle deflection; the default carries the force the first measured u applies)."""
+    ctrl_d = controller if controller is not None else model.controller
+    if ctrl_d is None:
+        raise SystemDefinitionError("the model has no 'controller': re-simulation needs one (see the MODEL.json schema)")
+    if meas.q_ref is None:
+        raise SystemDefinitionError(f"{meas.name}: re-simulation needs the reference column q_ref")
+    if not (isinstance(substeps, (int, np.integer)) and 1 <= substeps <= 10_000):
+        raise SystemDefinitionError(f"substeps = {substeps!r} must be an integer in [1, 10000]")
+    ctrl = SampledController.from_schema(ctrl_d)
+    dt = meas.dt
+    res = resolution_of(meas.q) if resolution is None else check_finite_positive("resolution", resolution,
+                                                                                 allow_zero=True)
+    p, cog, bases = model_arrays(model)
+    fext = meas.force_ext() + (0.0 if force_noise is None else np.asarray(force_noise, float))
+    if fext.shape != (meas.n,):
+        raise SystemDefinitionError(f"force_noise must have {meas.n} samples")
+    q0 = float(meas.q[0])
+    v0 = float((meas.q[min(5, meas.n - 1)] - meas.q[0]) / (min(5, meas.n - 1) * dt))
+    at_rest = abs(v0) * dt <= max(res, 1e-12)
+    u0 = float(meas.u[0])
+    e0 = q0 - float(meas.q_ref[0])
+    c = ctrl.array(dt)
+    # controller state so that its first output is the measured u[0] (the integral carries the
+    # force the loop needed before the record started)
+    I0 = -(u0 + c[1] * e0) / c[3] - c[8] * dt * e0 if (ctrl.kind == "pid" and c[3] != 0.0) else 0.0
+    sig0 = q0 if ctrl.derivative_on_measurement else e0
+    z0 = 0.0
+    if model.law == "lugre":
+        # the bristles carry the force that holds the mass at the start (quasi-static)
+        pos, neg = model.curve.positive, model.curve.negative
+        need = model.cm * u0 + fext[0] - model.offset - float(model.cogging_force(q0))
+        z0 = float(np.clip(need, -0.99 * neg.Fs, 0.99 * pos.Fs)) / model.sigma0 if at_rest else 0.0
+    x = np.array([q0, 0.0 if at_rest else v0, z0, 1.0 if (at_rest and model.law != "lugre") else 0.0,
+                  I0, 0.0, sig0, q0, q0])
+    if x0 is not None:
+        x0 = np.asarray(x0, float)
+        if x0.shape != (3,) or not np.all(np.isfinite(x0)):
+            raise SystemDefinitionError(f"x0 = {x0!r} must be three finite numbers (q, v, z)")
+        x[:3] = x0
+        x[3] = 1.0 if (x0[1] == 0.0 and model.law != "lugre") else 0.0
+    n = meas.n
+    qo, uo, vo, so = np.empty(n), np.empty(n), np.empty(n), np.zeros(n, np.bool_)
+    delay_sub = int(round(model.delay / (dt / substeps)))
+    done = _loop(p, cog, bases, c, np.ascontiguousarray(meas.q_ref), np.ascontiguousarray(fext), u0, res, dt,
+                 int(substeps), delay_sub, x, qo, uo, vo, so)
+    ok = done == n
+    msg = "" if ok else (f"the simulated state stopped being finite at t = {meas.t[done]:.6g} s: increase substeps "
+                         f"(now {substeps}) or check the model's parameters")
+    m = n if ok else done
+    return Simulation(meas.t[:m], qo[:m], uo[:m], vo[:m], so[:m], ok, msg)
