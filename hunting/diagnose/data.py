@@ -1,7 +1,8 @@
 """Measured signals for diagnosis: loaders for CSV, NumPy and MATLAB files with explicit units.
 
 Columns (any file type): ``t`` [s], ``q`` [m or rad], ``u`` (controller output, in the unit the
-motor constant multiplies), optional ``q_ref`` (reference) and ``f_ext`` (known external force).
+motor constant multiplies), optional ``q_ref`` (reference), ``f_ext`` (known external force on the
+load) and ``u_inj`` (a known signal added to the controller output, e.g. test pulses).
 MATLAB and NumPy files may use other variable names through ``names`` (e.g. the EMPS files:
 ``{"q": "qm", "u": "vir", "q_ref": "qg", "f_ext": "pulses_N"}``; those are tried by default);
 ``names={"f_ext": None}`` leaves a column out."""
@@ -16,15 +17,17 @@ import numpy as np
 from ..errors import SystemDefinitionError
 
 REQUIRED = ("t", "q", "u")
-OPTIONAL = ("q_ref", "f_ext")
+OPTIONAL = ("q_ref", "f_ext", "u_inj")
 ALIASES = {"t": ("t", "time"), "q": ("q", "qm", "position"), "u": ("u", "vir", "input"),
-           "q_ref": ("q_ref", "qg", "reference"), "f_ext": ("f_ext", "pulses_N")}
+           "q_ref": ("q_ref", "qg", "reference"), "f_ext": ("f_ext", "pulses_N"), "u_inj": ("u_inj",)}
 
 
 @dataclass(frozen=True)
 class Measurement:
     """Sampled signals, one row per sample (uniform sampling required). t [s]; q [m or rad];
-    u [V or N]; q_ref, f_ext : optional arrays; name : where they came from."""
+    u [V or N] (what drove the plant, injections included); q_ref, f_ext : optional arrays;
+    u_inj : optional known signal added to the controller output (an injected test signal, in
+    u's unit; part of u, so only re-simulation uses it); name : where they came from."""
 
     t: np.ndarray
     q: np.ndarray
@@ -32,6 +35,7 @@ class Measurement:
     q_ref: np.ndarray | None = None
     f_ext: np.ndarray | None = None
     name: str = "data"
+    u_inj: np.ndarray | None = None
 
     def __post_init__(self):
         n = np.asarray(self.t).size

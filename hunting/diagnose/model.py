@@ -11,7 +11,8 @@ Schema (keys beyond these are errors, so typos are caught):
      "friction": {"law": "coulomb-viscous" | "stribeck" | "switch" | "lugre",
                   "Fc": .., "Fs": .., "vs": .., "beta": .., "b": .., "sigma0": .., "sigma1": ..,
                   "sigma2": (alias of b), "Fc_neg": .., ... (direction-dependent values)},
-     "controller": {"type": "pid", "form": "PDI" | "K", ...} | {"type": "pd-velocity-loop", ...}}
+     "controller": {"type": "pid", "form": "PDI" | "K", ...} | {"type": "pd-velocity-loop", ...},
+     "sensor": {"resolution": 1e-6, "noise": 2e-7}}          # [m]; optional (see resimulate.py)
 """
 from __future__ import annotations
 
@@ -40,7 +41,9 @@ class NominalModel:
     law is lugre; controller : the controller description (dict), or None; source : the dict.
     cogging : tuple of :class:`hunting.models.plant.Cogging` components (harmonic or table),
     summed; delay [s] : actuation delay (the plant
-    receives cm u(t - delay)). All forces act like friction: m q'' = cm u - F(q') - offset - F_cog(q)."""
+    receives cm u(t - delay)); resolution [m] and sensor_noise [m] : the position sensor's
+    quantization step and noise standard deviation before quantization (used by re-simulation;
+    resolution None: read from the data). All forces act like friction: m q'' = cm u - F(q') - offset - F_cog(q)."""
 
     mass: float
     cm: float
@@ -53,12 +56,17 @@ class NominalModel:
     source: dict = field(default_factory=dict)
     cogging: tuple = ()
     delay: float = 0.0
+    resolution: float | None = None
+    sensor_noise: float = 0.0
 
     def __post_init__(self):
         check_finite_positive("mass", self.mass)
         check_finite_positive("motor_constant", self.cm)
         check_finite("offset", self.offset)
         check_finite_positive("delay", self.delay, allow_zero=True)
+        check_finite_positive("sensor_noise", self.sensor_noise, allow_zero=True)
+        if self.resolution is not None:
+            check_finite_positive("sensor resolution", self.resolution, allow_zero=True)
         if not all(isinstance(c, Cogging) for c in self.cogging):
             raise SystemDefinitionError(f"cogging = {self.cogging!r} must be a tuple of Cogging components")
         object.__setattr__(self, "cogging", tuple(self.cogging))
@@ -120,6 +128,8 @@ class NominalModel:
         d = {"plant": plant, "friction": fr}
         if self.controller is not None:
             d["controller"] = self.controller
+        if self.resolution is not None or self.sensor_noise:
+            d["sensor"] = {k: v for k, v in (("resolution", self.resolution), ("noise", self.sensor_noise)) if v}
         return d
 
     @staticmethod
@@ -135,10 +145,14 @@ class NominalModel:
     def from_dict(d: dict) -> "NominalModel":
         if not isinstance(d, dict):
             raise SystemDefinitionError(f"model = {d!r} must be a JSON object")
-        unknown = set(d) - {"preset", "set", "plant", "friction", "controller"}
+        unknown = set(d) - {"preset", "set", "plant", "friction", "controller", "sensor"}
         if unknown:
             raise SystemDefinitionError(f"model: unknown keys {sorted(unknown)}; allowed: preset, set, plant, "
-                                        "friction, controller")
+                                        "friction, controller, sensor")
+        sensor = d.get("sensor", {})
+        if not isinstance(sensor, dict) or set(sensor) - {"resolution", "noise"}:
+            raise SystemDefinitionError(f"model sensor = {sensor!r}: allowed keys are 'resolution' and 'noise' [m]")
+        sens = dict(resolution=sensor.get("resolution"), sensor_noise=float(sensor.get("noise", 0.0)))
         if "preset" in d:
             from ..models import preset
             loop = preset(d["preset"], **d.get("set", {}))
@@ -146,7 +160,7 @@ class NominalModel:
             law = "lugre" if isinstance(fr, LuGre) else "switch"
             return NominalModel(loop.plant.mass, loop.plant.motor_constant, fr.curve, law,
                                 sigma0=getattr(fr, "sigma0", None), sigma1=getattr(fr, "sigma1", None),
-                                controller=d.get("controller"), source=d)
+                                controller=d.get("controller"), source=d, **sens)
         for k in ("plant", "friction"):
             if k not in d:
                 raise SystemDefinitionError(f"model: missing {k!r} (or give a 'preset')")
@@ -187,7 +201,8 @@ class NominalModel:
             raise SystemDefinitionError("model friction: lugre needs 'sigma0' and 'sigma1'")
         return NominalModel(float(pl["mass"]), float(pl.get("motor_constant", 1.0)), DirectionalCurve(pos, neg), law,
                             offset=float(pl.get("offset", 0.0)), sigma0=fr.get("sigma0"), sigma1=fr.get("sigma1"),
-                            controller=ctrl, source=d, cogging=_cogging(pl.get("cogging", []), pl.get("cogging_table", [])), delay=float(pl.get("delay", 0.0)))
+                            controller=ctrl, source=d, cogging=_cogging(pl.get("cogging", []), pl.get("cogging_table", [])), delay=float(pl.get("delay", 0.0)),
+                            **sens)
 
 
 def _cogging(harmonics, tables) -> tuple:

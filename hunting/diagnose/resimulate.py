@@ -101,7 +101,7 @@ class SampledController:
         hold = 1
         if self.sample_time is not None:
             hold = int(round(self.sample_time / dt))
-            if hold < 1 or abs(hold * dt - self.sample_time) > 1e-6 * self.sample_time:
+            if hold < 1 or abs(hold * dt - self.sample_time) > 1e-3 * self.sample_time:
                 raise SystemDefinitionError(
                     f"controller sample_time = {self.sample_time!r} s is not an integer multiple of the data's "
                     f"sample interval {dt!r} s: resample the data or correct sample_time")
@@ -131,7 +131,7 @@ def _rates(q, v, z, s, fa, p, cog, bases):
 
 
 @numba.njit(cache=True, error_model="numpy", nogil=True)
-def _loop(p, cog, bases, ctrl, r, fext, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
+def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
           v_out, stuck_out):
     """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev] (updated in
     place). Returns the number of samples done (< r.size when the state stopped being finite)."""
@@ -139,9 +139,11 @@ def _loop(p, cog, bases, ctrl, r, fext, u_init, resolution, dt, substeps, delay_
     lugre = p[3] > 0.5
     hold = int(ctrl[8])
     u = u_init
+    uc = 0.0
     q, v, z, stuck = x[0], x[1], x[2], x[3] > 0.5
     for k in range(r.size):
-        y = resolution * math.floor(q / resolution + 0.5) if resolution > 0.0 else q
+        qm = q + noise[k]
+        y = resolution * math.floor(qm / resolution + 0.5) if resolution > 0.0 else qm
         if k % hold == 0:
             T = dt * hold
             if ctrl[0] == 1.0:
@@ -150,16 +152,17 @@ def _loop(p, cog, bases, ctrl, r, fext, u_init, resolution, dt, substeps, delay_
                 x[4] += T * e
                 x[5] = (ctrl[5] * x[5] + (sig - x[6])) / (ctrl[5] + T)
                 x[6] = sig
-                u = -(ctrl[1] * e + ctrl[2] * x[5] + ctrl[3] * x[4])
+                uc = -(ctrl[1] * e + ctrl[2] * x[5] + ctrl[3] * x[4])
             else:
                 qf = 0.5 * y + 0.5 * x[7]
-                u = ctrl[4] * (ctrl[1] * (r[k] - y) - (qf - x[8]) / T)
+                uc = ctrl[4] * (ctrl[1] * (r[k] - y) - (qf - x[8]) / T)
                 x[8] = qf
             x[7] = y
-            if u > ctrl[7]:
-                u = ctrl[7]
-            elif u < -ctrl[7]:
-                u = -ctrl[7]
+        u = uc + inj[k]
+        if u > ctrl[7]:
+            u = ctrl[7]
+        elif u < -ctrl[7]:
+            u = -ctrl[7]
         q_out[k] = y
         u_out[k] = u
         v_out[k] = v
@@ -228,8 +231,8 @@ def model_arrays(model: NominalModel):
 @dataclass(frozen=True)
 class Simulation:
     """A re-simulated run on the measurement's instants: t [s], q (quantized like the data) [m],
-    u (controller output), v [m/s], stuck (bool, static laws only); ok/message as in the
-    integrators (the state stopped being finite)."""
+    u (controller output plus injection: comparable to the measured u), v [m/s], stuck (bool,
+    static laws only); ok/message as in the integrators (the state stopped being finite)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -255,13 +258,18 @@ def resolution_of(q: np.ndarray) -> float:
 
 
 def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | None = None,
-               substeps: int = 20, resolution: float | None = None, force_noise=None, x0=None) -> Simulation:
+               substeps: int = 20, resolution: float | None = None, force_noise=None, x0=None, sensor_noise: float | None = None,
+               seed: int = 0) -> Simulation:
     """Re-simulate the closed loop of ``model`` on the instants of ``meas``, tracking its q_ref,
-    with its f_ext, from its initial position (at rest when the measured speed is below one count
+    with its f_ext and its injection u_inj (added to the controller output, before the
+    saturation), from its initial position (at rest when the measured speed is below one count
     per sample). controller : the schema dict (default: the model's); resolution [m] : encoder
-    quantization (default: read from the data); force_noise : optional (n,) force [N] added to the
+    quantization (default: the model's ``sensor`` resolution, else read from the data); force_noise : optional (n,) force [N] added to the
     drive (for synthetic data); x0 : (q [m], v [m/s], z [m]) to start from instead (z: LuGre's
-    bristle deflection; the default carries the force the first measured u applies)."""
+    bristle deflection; the default carries the force the first measured u applies);
+    sensor_noise [m] : standard deviation of the position noise before quantization (default: the
+    model's ``sensor`` noise, else 0; near rest it dithers the controller output, which moves a
+    LuGre contact), drawn with ``seed``."""
     ctrl_d = controller if controller is not None else model.controller
     if ctrl_d is None:
         raise SystemDefinitionError("the model has no 'controller': re-simulation needs one (see the MODEL.json schema)")
@@ -271,6 +279,8 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
         raise SystemDefinitionError(f"substeps = {substeps!r} must be an integer in [1, 10000]")
     ctrl = SampledController.from_schema(ctrl_d)
     dt = meas.dt
+    if resolution is None and model.resolution is not None:
+        resolution = model.resolution
     res = resolution_of(meas.q) if resolution is None else check_finite_positive("resolution", resolution,
                                                                                  allow_zero=True)
     p, cog, bases = model_arrays(model)
@@ -280,12 +290,13 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
     q0 = float(meas.q[0])
     v0 = float((meas.q[min(5, meas.n - 1)] - meas.q[0]) / (min(5, meas.n - 1) * dt))
     at_rest = abs(v0) * dt <= max(res, 1e-12)
+    inj = np.zeros(meas.n) if meas.u_inj is None else np.ascontiguousarray(meas.u_inj)
     u0 = float(meas.u[0])
     e0 = q0 - float(meas.q_ref[0])
     c = ctrl.array(dt)
     # controller state so that its first output is the measured u[0] (the integral carries the
     # force the loop needed before the record started)
-    I0 = -(u0 + c[1] * e0) / c[3] - c[8] * dt * e0 if (ctrl.kind == "pid" and c[3] != 0.0) else 0.0
+    I0 = -(u0 - inj[0] + c[1] * e0) / c[3] - c[8] * dt * e0 if (ctrl.kind == "pid" and c[3] != 0.0) else 0.0
     sig0 = q0 if ctrl.derivative_on_measurement else e0
     z0 = 0.0
     if model.law == "lugre":
@@ -304,7 +315,10 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
     n = meas.n
     qo, uo, vo, so = np.empty(n), np.empty(n), np.empty(n), np.zeros(n, np.bool_)
     delay_sub = int(round(model.delay / (dt / substeps)))
-    done = _loop(p, cog, bases, c, np.ascontiguousarray(meas.q_ref), np.ascontiguousarray(fext), u0, res, dt,
+    sn = model.sensor_noise if sensor_noise is None else check_finite_positive("sensor_noise", sensor_noise,
+                                                                               allow_zero=True)
+    noise = np.random.default_rng(seed).normal(0.0, sn, n) if sn > 0 else np.zeros(n)
+    done = _loop(p, cog, bases, c, np.ascontiguousarray(meas.q_ref), np.ascontiguousarray(fext), inj, noise, u0, res, dt,
                  int(substeps), delay_sub, x, qo, uo, vo, so)
     ok = done == n
     msg = "" if ok else (f"the simulated state stopped being finite at t = {meas.t[done]:.6g} s: increase substeps "

@@ -8,7 +8,16 @@ n (1 - rho1) / (1 + rho1), rho1 the lag-1 autocorrelation of the extended model'
 because smoothed residuals are far from white), and (2) it lowers the RMS residual on the validation data by at
 least ``min_gain`` (relative). Hyper-parameters (a cogging pitch, a Stribeck velocity) are chosen
 on the fitting data only. Causes are ranked by how much the validation RMS grows when each is
-dropped from the final extended model."""
+dropped from the final extended model.
+
+Stick-channel causes (``CHANNEL = "stick"``, e.g. presliding) are judged on the samples where the
+(force-extended) model says the mass sticks: a chi-square test of the motion there against the
+sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
+the re-simulated position error (controller known) or in the stick-segment displacement.
+
+The behaviour view (when the model has a controller and the data a reference): the validation run
+re-simulated with the nominal and the extended model, compared with the measurement
+(:mod:`hunting.diagnose.behaviour`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -41,25 +50,29 @@ class Cause:
     sigma: dict
     gain: dict
     hyper: dict = field(default_factory=dict)
+    theta: np.ndarray | None = None
 
     def as_dict(self) -> dict:
         return dict(name=self.name, score=self.score, statistic=self.statistic, p_value=self.p_value,
-                    parameters=self.parameters, sigma=self.sigma, gain=self.gain)
+                    parameters=self.parameters, sigma=self.sigma, gain=self.gain, role="selected")
 
 
 @dataclass
 class Diagnosis:
-    """causes : ranked list of Cause; nominal / extended : validation force-residual RMS [N];
+    """causes : ranked list of Cause (force channel first, then stick channel); nominal /
+    extended : validation force-residual RMS [N] (None when the force channel was skipped);
     criterion : the selection rule; kin_fit, kin_val : kinematics; r_* : residuals (n,) of the
     nominal and extended model on both sets (NaN where not used: |v| small or filter edges);
     rejected : candidates that failed the criterion at the step where selection stopped;
     alternatives : causes that pass the criterion on their own but add nothing once the selected
-    ones are in (their stand-alone parameters: e.g. a constant offset that a direction-dependent
-    viscous term explains as well)."""
+    ones are in (their stand-alone parameters and gain: e.g. a constant offset that a
+    direction-dependent viscous term explains as well); extended_model : the nominal model with
+    every selected extension; behaviour : the behaviour view on the validation data (None without
+    a controller or a reference); notes : what was skipped and why."""
 
     causes: list
-    nominal: float
-    extended: float
+    nominal: float | None
+    extended: float | None
     criterion: str
     model: NominalModel
     kin_fit: Kinematics
@@ -69,13 +82,43 @@ class Diagnosis:
     r_val_extended: np.ndarray
     rejected: list = field(default_factory=list)
     alternatives: list = field(default_factory=list)
+    extended_model: NominalModel | None = None
+    behaviour: dict | None = None
+    notes: list = field(default_factory=list)
+
+    def gains(self) -> list:
+        """Validation metrics of the nominal against the extended model: force residual RMS [N],
+        and from the behaviour view position and drive-force RMS errors of the re-simulation,
+        stick-error, cycle-amplitude and cycle-period errors against the measurement."""
+        out = []
+        if self.nominal is not None:
+            out.append(dict(metric="force residual RMS [N]", nominal=self.nominal, extended=self.extended))
+        b = self.behaviour
+        if b:
+            for key, label in (("position_rms", "re-simulated position RMS error [m]"),
+                               ("force_rms", "re-simulated drive force RMS error [N]")):
+                out.append(dict(metric=label, nominal=b["nominal"][key], extended=b["extended"][key]))
+            for key, label in (("stick_error", "stick error RMS [m]"), ("cycle_amplitude", "cycle amplitude [m]"),
+                               ("cycle_period", "cycle period [s]"), ("final_error", "final error [m]")):
+                m = b["measured"][key]
+                if m is None:
+                    continue
+                err = [None if b[k][key] is None else abs(b[k][key] - m) for k in ("nominal", "extended")]
+                out.append(dict(metric=f"|{label} - measured {m:.4g}|", nominal=err[0], extended=err[1]))
+            out.append(dict(metric="ends at rest (measured: {})".format(b["measured"]["at_rest"]),
+                            nominal=b["nominal"]["at_rest"], extended=b["extended"]["at_rest"]))
+        return out
 
     def as_dict(self) -> dict:
-        return dict(causes=[c.as_dict() for c in self.causes],
+        alts = [dict(name=a["name"], score=0.0, parameters=a["parameters"], gain=a["gain"], role="alternative",
+                     absorbed_by=a["absorbed_by"]) for a in self.alternatives]
+        return dict(causes=[c.as_dict() for c in self.causes] + alts,
                     gain=dict(metric="force residual RMS [N] on the validation data", nominal=self.nominal,
                               extended=self.extended),
+                    gains=self.gains(), behaviour=self.behaviour, notes=self.notes,
                     criterion=self.criterion, rejected=self.rejected, alternatives=self.alternatives,
-                    nominal_model=self.model.to_dict())
+                    nominal_model=self.model.to_dict(),
+                    extended_model=None if self.extended_model is None else self.extended_model.to_dict())
 
 
 def _rms(r) -> float:
@@ -97,12 +140,14 @@ def _designs(name, kin_f, kin_v, model, mf, mv):
 
 
 def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
-             max_causes: int = 4, min_gain: float = 0.02, alpha: float = 1e-3, window: float | None = None) -> Diagnosis:
+             max_causes: int = 4, min_gain: float = 0.02, alpha: float = 1e-3, window: float | None = None,
+             behaviour: bool = True) -> Diagnosis:
     """Rank the causes of the mismatch between the model and the measured data.
 
     fit : data to fit extensions on; validate : data to judge them on (default: the last 40 % of
     ``fit``, the first 60 % being used for fitting); causes : names to consider (default all);
-    max_causes : bound on the selection; min_gain, alpha : the criterion (module docstring)."""
+    max_causes : bound on the force-channel selection; min_gain, alpha : the criterion (module
+    docstring); behaviour : re-simulate the validation run (needs a controller and q_ref)."""
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -112,9 +157,44 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
     kf = kinematics(fit, model.cm, window=window)
     kv = kinematics(validate, model.cm, window=window)
+    crit = CRITERION.format(alpha=alpha, min_gain=min_gain)
+    force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
+    stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
+    notes: list = []
+    nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
+    if kf.moving.sum() >= 50 and kv.moving.sum() >= 50:
+        fc = _force_channel(force_names, kf, kv, model, max_causes, min_gain, alpha)
+    else:
+        notes.append("force channel skipped: fewer than 50 moving samples (|v| > 2 % of the maximum) in the fitting "
+                     "or validation data")
+        fc = dict(causes=[], nominal=None, extended=None, rejected=[], alternatives=[], model=model,
+                  r_fit=nan_f, r_val_nom=nan_v, r_val_ext=nan_v)
+    ext = fc["model"]
+    result, rejected = list(fc["causes"]), list(fc["rejected"])
+    can_sim = model.controller is not None and validate.q_ref is not None and fit.q_ref is not None
+    for name in stick_names:
+        cause, row, ext = _stick_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim)
+        if cause is not None:
+            result.append(cause)
+        elif row is not None:
+            rejected.append(row)
+    view = None
+    if behaviour and model.controller is not None and validate.q_ref is not None:
+        from .behaviour import compare
+        from .resimulate import resimulate, resolution_of
+        res = model.resolution if model.resolution is not None else resolution_of(validate.q)
+        view = compare(validate, {"nominal": resimulate(validate, model), "extended": resimulate(validate, ext)},
+                       model.cm, res)
+    elif behaviour:
+        notes.append("behaviour view skipped: it needs the model's 'controller' and the reference q_ref in the data")
+    return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
+                     fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes)
+
+
+def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
+    """Forward selection on the force residual (module docstring); returns the selected causes,
+    the extended model and the residuals."""
     mf, mv = kf.moving, kv.moving
-    if mf.sum() < 50 or mv.sum() < 50:
-        raise SystemDefinitionError("too few moving samples (|v| > 2 % of the maximum) to diagnose the force balance")
     rf0 = residual(kf, model)[mf]
     rv0 = residual(kv, model)[mv]
     chosen: list = []                      # (name, Phi_f, Phi_v, hyper, F, p, rms_before, rms_after)
@@ -122,7 +202,6 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     Pv = np.zeros((rv0.size, 0))
     rejected = []
     alone: dict = {}                       # step-1 fits that pass the criterion on their own
-    crit = CRITERION.format(alpha=alpha, min_gain=min_gain)
     for _ in range(max_causes):
         th, *_ = np.linalg.lstsq(Pf, rf0, rcond=None) if Pf.shape[1] else (np.zeros(0),)
         rf_cur = rf0 - Pf @ th
@@ -155,7 +234,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             row = (name, df, dv, hyper, float(F), p, _rms(rv_cur), rms_v, gain)
             if p < alpha and gain >= min_gain:
                 if not chosen:
-                    alone[name] = (CAUSES[name].parameters(t2, hyper, model), gain)
+                    alone[name] = (CAUSES[name].parameters(t2, hyper, model),
+                                   dict(metric="force residual RMS [N], validation, alone", nominal=_rms(rv_cur),
+                                        extended=rms_v))
                 if best is None or gain > best[-1]:
                     best = row
             else:
@@ -202,8 +283,12 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
                     grad[j] = (mod.parameters(tp, hyper, model)[key] - pars[key]) / h
                 sig[key] = float(np.sqrt(max(grad @ cov[sl, sl] @ grad, 0.0)))
             result.append(Cause(name, dropped / full - 1, F, p, pars, sig,
-                                dict(metric="force residual RMS [N], validation", nominal=before, extended=after), hyper))
+                                dict(metric="force residual RMS [N], validation", nominal=before, extended=after), hyper,
+                                th[sl].copy()))
         result.sort(key=lambda c: -c.score)
+    ext = model
+    for c in result:
+        ext = CAUSES[c.name].extend(ext, c.theta, c.hyper)
     rf_full = np.full(kf.t.size, np.nan)
     rf_full[mf] = rf0
     rvn = np.full(kv.t.size, np.nan)
@@ -211,6 +296,44 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     rve = np.full(kv.t.size, np.nan)
     rve[mv] = rv_ext
     picked = {c.name for c in result}
-    alternatives = [dict(name=k, parameters=v[0], validation_gain=v[1], absorbed_by=sorted(picked))
+    alternatives = [dict(name=k, parameters=v[0], gain=v[1], absorbed_by=sorted(picked))
                     for k, v in alone.items() if k not in picked]
-    return Diagnosis(result, _rms(rv0), _rms(rv_ext), crit, model, kf, kv, rf_full, rvn, rve, rejected, alternatives)
+    return dict(causes=result, nominal=_rms(rv0), extended=_rms(rv_ext), rejected=rejected, alternatives=alternatives,
+                model=ext, r_fit=rf_full, r_val_nom=rvn, r_val_ext=rve)
+
+
+def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
+    """Judge one stick-channel cause (module docstring). Returns (Cause or None, rejected row or
+    None, the model extended by it when accepted)."""
+    from .resimulate import resimulate, resolution_of
+    segs = mod.segments(kf, model)
+    if sum(b - a + 1 for a, b in segs) < 200:
+        return None, None, model
+    res = model.resolution if model.resolution is not None else resolution_of(fit.q)
+    chi2, p, r0 = mod.evidence(kf, model, segs, res)
+    if can_sim:
+        theta, _ = mod.fit_behaviour(fit, model)
+        ext = mod.extend(model, theta, {})
+
+        def err(m):
+            sim = resimulate(val, m)
+            return float(np.sqrt(np.mean((sim.q - val.q[:sim.q.size]) ** 2)))
+        before, after = err(model), err(ext)
+        metric = "re-simulated position RMS error [m], validation"
+    else:
+        theta = mod.fit_quasistatic(kf, model, segs)
+        ext = mod.extend(model, theta, {})
+        sv = mod.segments(kv, model)
+        if sum(b - a + 1 for a, b in sv) < 50:
+            return None, dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=None,
+                              reason="no stick segments in the validation data"), model
+        d, W, ids = mod.regressors(kv, model, sv)
+        dm = lambda x: x - (np.bincount(ids, x) / np.bincount(ids))[ids]  # noqa: E731
+        before, after = _rms(dm(d)), _rms(dm(d - W @ theta))
+        metric = "stick-segment displacement RMS [m], validation"
+    gain = 1 - after / max(before, 1e-300)
+    if not (p < alpha and gain >= min_gain):
+        return None, dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=gain), model
+    pars = mod.parameters(theta, {}, model)
+    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, {k: float("nan") for k in pars},
+                  dict(metric=metric, nominal=before, extended=after), {}, np.asarray(theta)), None, ext)

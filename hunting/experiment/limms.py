@@ -9,7 +9,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 
 from ..errors import SystemDefinitionError
 from ..identify import (cogging_table, curve_from_fit, estimate_frf, fit_double_integrator, fit_second_order,
@@ -197,28 +196,9 @@ def stick_phases(rec: Record, resolution: float, *, window: float = 0.03, counts
     mass creeps through while the integral action loads the bristles).
     Returns (first, last) sample indices. (With presliding there is no exact stick; the thesis
     decides it by inspection.)"""
-    y = rec.y
-    fs = 1.0 / (rec.t[1] - rec.t[0])
-    w = max(2, int(window * fs))
-    tol = counts * resolution + 1e-12
-    n = y.size
-    if n < w:
-        return []
-    win = sliding_window_view(y, w)
-    still = (win.max(axis=1) - win.min(axis=1)) <= tol
-    phases, k = [], 0
-    last_ref = y[0]
-    while k < still.size:
-        if still[k] and abs(y[k] - last_ref) > moved:
-            j = k
-            while j + 1 < still.size and still[j + 1]:
-                j += 1
-            phases.append((k, j + w - 1))
-            last_ref = y[j + w - 1]
-            k = j + w
-        else:
-            k += 1
-    return phases
+    from ..diagnose.behaviour import stick_phases as phases
+    return phases(rec.y, float(rec.t[1] - rec.t[0]), resolution, window=window, counts=counts, moved=moved,
+                  origin=float(rec.y[0]))
 
 
 def experimental_event_map(motor: VirtualMotor, K: float, grid, *, t_max: float = 20.0, seed: int = 6,

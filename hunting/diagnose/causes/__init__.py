@@ -3,9 +3,22 @@ vocabulary of ``hunting diagnose``), a one-line ``DESCRIPTION``, ``hypers(kin, m
 hyper-parameter variants to try, chosen from the fitting data: e.g. cogging pitches),
 ``design(kin, model, hyper)`` (regressors (n, k) of the force residual, linear in the
 extension's parameters) and ``parameters(theta, hyper, model)`` turning the fitted coefficients
-into named physical parameters. Adding a cause is adding a module and listing it here."""
-from . import asymmetry, cogging, delay, mass, offset, stribeck, viscous
+into named physical parameters, and ``extend(model, theta, hyper)`` returning the extended
+NominalModel (what the behaviour view re-simulates). Adding a cause is adding a module and
+listing it here."""
+from ..model import NominalModel
+from ...models.friction import DirectionalCurve
 
-CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, stribeck, viscous, mass, delay)}
+
+def with_curves(model: NominalModel, pos, neg=None) -> NominalModel:
+    """The model with its friction curves mapped: positive direction by ``pos``, negative by
+    ``neg`` (default: the same map)."""
+    neg = pos if neg is None else neg
+    return model.replace(curve=DirectionalCurve(pos(model.curve.positive), neg(model.curve.negative)))
+
+
+from . import asymmetry, cogging, delay, mass, offset, presliding, stribeck, viscous  # noqa: E402
+
+CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, stribeck, viscous, mass, delay, presliding)}
 
 __all__ = ["CAUSES"]

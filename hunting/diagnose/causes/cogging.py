@@ -2,6 +2,8 @@
 spatial period found from the residual's Lomb-Scargle spectrum against position."""
 import numpy as np
 
+from ...models.plant import Cogging
+
 NAME = "cogging"
 DESCRIPTION = "force periodic in position (cogging)"
 HARMONICS = 3
@@ -45,3 +47,8 @@ def parameters(theta, hyper, model) -> dict:
     out = {"pitch": hyper["pitch"]}
     out.update({f"amplitude_{k + 1}": a for k, a in enumerate(amp)})
     return out
+
+
+def extend(model, theta, hyper):
+    comp = Cogging.harmonic(hyper["pitch"], cos=list(theta[0::2]), sin=list(theta[1::2]))
+    return model.replace(cogging=model.cogging + (comp,))

@@ -14,3 +14,7 @@ def design(kin, model, hyper):
 
 def parameters(theta, hyper, model) -> dict:
     return {"delay": float(theta[0])}
+
+
+def extend(model, theta, hyper):
+    return model.replace(delay=max(model.delay + float(theta[0]), 0.0))

@@ -13,3 +13,7 @@ def design(kin, model, hyper):
 
 def parameters(theta, hyper, model) -> dict:
     return {"mass": float(model.mass + theta[0])}
+
+
+def extend(model, theta, hyper):
+    return model.replace(mass=model.mass + float(theta[0]))

@@ -15,3 +15,7 @@ def design(kin, model, hyper):
 
 def parameters(theta, hyper, model) -> dict:
     return {"offset": float(model.offset + theta[0])}
+
+
+def extend(model, theta, hyper):
+    return model.replace(offset=model.offset + float(theta[0]))

@@ -1,6 +1,10 @@
 """A wrong velocity-weakening shape: Coulomb level change c1 sign(v) plus a Stribeck term
 c2 sign(v) exp(-(|v|/vs)^2) with vs searched on a logarithmic grid over the measured speeds."""
+from dataclasses import replace
+
 import numpy as np
+
+from . import with_curves
 
 NAME = "stribeck"
 DESCRIPTION = "velocity-weakening (Stribeck) shape: levels and vs"
@@ -22,3 +26,13 @@ def design(kin, model, hyper):
 def parameters(theta, hyper, model) -> dict:
     c = model.curve.positive
     return {"Fc": float(c.Fc + theta[0]), "Fs": float(c.Fc + theta[0] + theta[1]), "vs": hyper["vs"]}
+
+
+def extend(model, theta, hyper):
+    """Levels Fc + theta0 and Fs = Fc + theta0 + theta1 at the fitted vs (replacing the curve's
+    own Stribeck term when it had one)."""
+    def new(c):
+        Fc = max(c.Fc + float(theta[0]), 0.0)
+        return replace(c, Fc=Fc, Fs=max(Fc + float(theta[1]), Fc), vs=hyper["vs"], beta=2.0)
+    out = with_curves(model, new)
+    return out.replace(law="stribeck") if model.law == "coulomb-viscous" else out

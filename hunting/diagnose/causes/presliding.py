@@ -1,0 +1,143 @@
+"""Finite stick stiffness (presliding): the mass moves while the friction force stays below the
+break-away level, where a Switch-type model holds it still (chapters 4.4, 10.4.2, 11.3.3).
+
+A stick-channel cause: it is judged on the samples where the nominal model says the mass sticks
+(|v| below ``v_stick`` and the force friction must carry, F = cm u + f_ext - offset - F_cog - m a,
+inside the stick set (-Fs-, Fs+)), over segments of at least ``min_time``. The nominal model
+predicts no motion there; LuGre predicts quasi-static bristle deflection z = F / sigma0 with
+z' = v - sigma0 |v| z / g, i.e. along a segment
+
+    dq = (dF / sigma0) / (1 - s F / Fs_s),   s = sign of the loading dF (the direction of motion),
+
+so the displacement from the segment's start is w / sigma0 with w = sum dF / (1 - s F / Fs_s):
+linear in 1/sigma0 (segment offsets free): that fit is used when the controller is unknown. When
+it is known, sigma0 is fitted on the behaviour instead: the LuGre loop re-simulated from the
+measured reference (with the sensor's quantization and noise, which near rest dither the
+controller output and make a LuGre contact creep) must follow the measured positions; sigma0
+minimizes the position RMS error (golden section on log sigma0, 1e3 .. 1e9 N/m).
+
+Evidence: under the nominal model the measured position in the stick segments varies only by
+quantization and sensor noise (variance at most res^2/4 + noise^2); the chi-square of the
+segment-demeaned displacement against it gives the p-value.
+
+The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 = sqrt(sigma0 m)
+(damping ratio 0.5 of the presliding resonance) because creeping data cannot determine it."""
+import numpy as np
+from scipy.signal import savgol_filter
+
+NAME = "presliding"
+DESCRIPTION = "finite stick stiffness: motion while |F| < Fs (LuGre sigma0)"
+CHANNEL = "stick"
+ZETA = 0.5
+
+
+def friction_force(kin, model) -> np.ndarray:
+    """The force friction must carry [N] (n,), from the measured drive and motion."""
+    from ..kinematics import residual
+    return residual(kin, model) + model.friction(kin.v)
+
+
+def v_stick(kin, model) -> float:
+    """Speed [m/s] below which the nominal model's mass counts as stuck: a tenth of the smaller
+    Stribeck velocity, or 2 % of the largest measured speed for curves without one."""
+    pos, neg = model.curve.positive, model.curve.negative
+    if pos.Fs > pos.Fc or neg.Fs > neg.Fc:
+        return 0.1 * min(pos.vs, neg.vs)
+    return 0.02 * float(np.max(np.abs(kin.v)))
+
+
+def segments(kin, model, *, min_time: float = 0.05) -> list[tuple[int, int]]:
+    """(first, last) index ranges (inclusive) where the nominal model sticks (module docstring)."""
+    F = friction_force(kin, model)
+    Fsp, Fsn = model.curve.positive.Fs, model.curve.negative.Fs
+    dt = float(kin.t[1] - kin.t[0])
+    w = int(round(kin.window / dt))
+    ok = (np.abs(kin.v) < v_stick(kin, model)) & (F < 0.98 * Fsp) & (F > -0.98 * Fsn)
+    ok[:w] = False
+    ok[-w:] = False
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(np.int8), [0]])))
+    need = max(int(min_time / dt), 20)
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2]) if b - a >= need]
+
+
+def _smooth(x: np.ndarray, L: int) -> np.ndarray:
+    L = min(L, x.size if x.size % 2 else x.size - 1)
+    return savgol_filter(x, L, 2) if L >= 5 else x
+
+
+def regressors(kin, model, segs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(d, W, seg_id) on the stick samples: displacement from each segment's start [m] (m,), the
+    LuGre regressor W (m, 1) [N] (d = W / sigma0 + const per segment) and the segment index."""
+    F = friction_force(kin, model)
+    dt = float(kin.t[1] - kin.t[0])
+    L = max(int(0.02 / dt) | 1, 5)
+    ds, ws, ids = [], [], []
+    Fsp, Fsn = model.curve.positive.Fs, model.curve.negative.Fs
+    for i, (a, b) in enumerate(segs):
+        f = _smooth(F[a:b + 1], L)
+        # the loading direction from a force smoothed over ~100 ms (noise would flip it sample
+        # by sample and pump the hysteresis of the regressor)
+        s = np.where(np.diff(_smooth(f, 5 * L), prepend=f[0]) >= 0, 1.0, -1.0)
+        g = np.where(s > 0, Fsp, Fsn)
+        ws.append(np.cumsum(np.diff(f, prepend=f[0]) / np.maximum(1.0 - s * f / g, 0.05)))
+        ds.append(kin.q[a:b + 1] - kin.q[a])
+        ids.append(np.full(b - a + 1, i))
+    return np.concatenate(ds), np.concatenate(ws)[:, None], np.concatenate(ids)
+
+
+def evidence(kin, model, segs, resolution: float) -> tuple[float, float, np.ndarray]:
+    """(chi-square statistic, p-value, demeaned displacement (m,)) of the stick segments."""
+    from scipy import stats
+    d, _, ids = regressors(kin, model, segs)
+    r0 = d - (np.bincount(ids, d) / np.bincount(ids))[ids]
+    var = resolution ** 2 / 4 + model.sensor_noise ** 2
+    dof = max(d.size - len(segs), 1)
+    chi2 = float(np.sum(r0 ** 2) / max(var, 1e-30))
+    return chi2, float(stats.chi2.sf(chi2, dof)), r0
+
+
+def fit_quasistatic(kin, model, segs) -> np.ndarray:
+    """theta = [1 / sigma0] by least squares on the stick segments (segment offsets free)."""
+    d, W, ids = regressors(kin, model, segs)
+    A = np.column_stack([W, np.eye(len(segs))[ids]]) if len(segs) < 200 else W
+    th, *_ = np.linalg.lstsq(A, d, rcond=None)
+    return th[:1]
+
+
+def fit_behaviour(meas, model, *, max_evals: int = 24) -> tuple[np.ndarray, float]:
+    """theta = [1 / sigma0] minimizing the position RMS error of the re-simulated LuGre loop on
+    ``meas`` (golden section on log10 sigma0 in [3, 9], bounded by max_evals re-simulations).
+    Returns (theta, the RMS error [m])."""
+    from ..resimulate import resimulate
+    cache = {}
+
+    def cost(lg):
+        if lg not in cache:
+            sim = resimulate(meas, extend(model, np.array([10.0 ** -lg]), {}))
+            n = sim.q.size
+            cache[lg] = float(np.sqrt(np.mean((sim.q - meas.q[:n]) ** 2))) if sim.ok else np.inf
+        return cache[lg]
+    grid = np.linspace(3.0, 9.0, 7)
+    k = int(np.argmin([cost(g) for g in grid]))
+    a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    gr = (np.sqrt(5) - 1) / 2
+    c, d = b - gr * (b - a), a + gr * (b - a)
+    while len(cache) < max_evals and b - a > 0.01:
+        if cost(c) < cost(d):
+            b, d = d, c
+            c = b - gr * (b - a)
+        else:
+            a, c = c, d
+            d = a + gr * (b - a)
+    best = min(cache, key=cache.get)
+    return np.array([10.0 ** -best]), cache[best]
+
+
+def parameters(theta, hyper, model) -> dict:
+    sigma0 = 1.0 / theta[0] if theta[0] > 0 else float("inf")
+    return {"sigma0": float(sigma0), "sigma1": float(np.sqrt(sigma0 * model.mass)) * 2 * ZETA}
+
+
+def extend(model, theta, hyper):
+    p = parameters(theta, hyper, model)
+    return model.replace(law="lugre", sigma0=p["sigma0"], sigma1=p["sigma1"])
