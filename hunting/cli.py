@@ -146,12 +146,16 @@ def _cmd_diagnose(args) -> int:
     val = load(args.validate, names) if args.validate else None
     model = NominalModel.from_json(args.model)
     dg = diagnose(fit, model, val)
-    print(f"validation force-residual RMS: nominal {dg.nominal:.4g} N -> extended {dg.extended:.4g} N")
+    for g in dg.gains():
+        print(f"validation {g['metric']}: nominal {g['nominal']} -> extended {g['extended']}")
+    for note in dg.notes:
+        print(f"note: {note}")
     print(f"criterion: {dg.criterion}")
     if not dg.causes:
         print("no cause found: the nominal model explains the data within the criterion")
     for i, c in enumerate(dg.causes):
-        pars = ", ".join(f"{k} = {v:.5g} +- {c.sigma.get(k, float('nan')):.2g}" for k, v in c.parameters.items())
+        pars = ", ".join(f"{k} = {v:.5g}" + ("" if c.sigma.get(k) is None else f" +- {c.sigma[k]:.2g}")
+                         for k, v in c.parameters.items())
         print(f"  {i + 1}. {c.name:<10} score {c.score:.3g}  p {c.p_value:.2g}  {pars}")
     for a in dg.alternatives:
         print(f"     (also explains the data alone: {a['name']} {a['parameters']}; absorbed by {a['absorbed_by']})")

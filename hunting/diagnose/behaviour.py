@@ -70,7 +70,7 @@ def _final_stretch(q_ref: np.ndarray, min_samples: int) -> int | None:
     return start if q_ref.size - start >= min_samples else None
 
 
-def behaviour(t: np.ndarray, q: np.ndarray, q_ref: np.ndarray, resolution: float, *, rest_counts: int = 10,
+def behaviour(t: np.ndarray, q: np.ndarray, q_ref: np.ndarray, resolution: float, *, rest_counts: int = 25,
               **stick_kw) -> Behaviour:
     """The behaviour of one run (see the module docstring); t, q, q_ref (n,)."""
     dt = float(t[1] - t[0])

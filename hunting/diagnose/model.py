@@ -86,6 +86,12 @@ class NominalModel:
         out[n] = -neg.level(-v[n]) + neg.b * v[n]
         return out
 
+    def v_stick(self) -> float:
+        """Speed [m/s] below which this model's mass counts as stuck when judging data: a tenth
+        of the smaller Stribeck velocity (0 for curves without a Stribeck dip)."""
+        pos, neg = self.curve.positive, self.curve.negative
+        return 0.1 * min(pos.vs, neg.vs) if (pos.Fs > pos.Fc or neg.Fs > neg.Fc) else 0.0
+
     def cogging_force(self, q) -> np.ndarray:
         """F_cog(q) [N]: the sum of the components (0 without cogging)."""
         q = np.asarray(q, dtype=float)

@@ -11,6 +11,10 @@ from ..plotting import _plt, save
 from .select import Diagnosis
 
 
+def _pm(sigma) -> str:
+    return "" if sigma is None or not np.isfinite(sigma) else f" ± {sigma:.2g}"
+
+
 def write_json(dg: Diagnosis, path) -> None:
     Path(path).write_text(json.dumps(dg.as_dict(), indent=2, default=float))
 
@@ -39,25 +43,56 @@ def residual_figure(dg: Diagnosis, path) -> None:
     save(fig, path)
 
 
+def behaviour_figure(dg: Diagnosis, validate, path) -> None:
+    """Validation run: measured position error against the re-simulated nominal and extended
+    loops (the behaviour view)."""
+    from .resimulate import resimulate
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.plot(validate.t, validate.q - validate.q_ref, "k-", lw=1.0, label="measured")
+    for model, style, lab in ((dg.model, "C3--", "nominal"), (dg.extended_model, "C0-", "extended")):
+        sim = resimulate(validate, model)
+        ax.plot(sim.t, sim.q - validate.q_ref[:sim.q.size], style, lw=0.8,
+                label=f"{lab} (RMS error {dg.behaviour[lab]['position_rms']:.3g} m)")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("position error q - q_ref [m]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("behaviour on the validation data: re-simulated closed loop", fontsize=10)
+    fig.tight_layout()
+    save(fig, path)
+
+
 def write_report(dg: Diagnosis, directory) -> Path:
-    """JSON, the residual figure and index.html in ``directory``; returns the HTML path."""
+    """JSON, the figures (force residual; behaviour when the view exists) and index.html in
+    ``directory``; returns the HTML path."""
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
     write_json(dg, d / "diagnosis.json")
-    residual_figure(dg, d / "residual.png")
+    imgs = []
+    if dg.nominal is not None:
+        residual_figure(dg, d / "residual.png")
+        imgs.append("residual.png")
+    if dg.behaviour is not None:
+        behaviour_figure(dg, dg.validation, d / "behaviour.png")
+        imgs.append("behaviour.png")
+    gains = "".join(f"<tr><td>{html.escape(g['metric'])}</td><td>{g['nominal']}</td><td>{g['extended']}</td></tr>"
+                    for g in dg.gains())
+    notes = "".join(f"<li>{html.escape(n)}</li>" for n in dg.notes)
     rows = "".join(
         f"<tr><td>{i + 1}</td><td>{html.escape(c.name)}</td><td>{c.score:.3g}</td><td>{c.p_value:.2g}</td>"
-        f"<td>{html.escape(', '.join(f'{k} = {v:.4g} ± {c.sigma.get(k, np.nan):.2g}' for k, v in c.parameters.items()))}</td>"
+        f"<td>{html.escape(', '.join(f'{k} = {v:.4g}' + _pm(c.sigma.get(k)) for k, v in c.parameters.items()))}</td>"
         f"<td>{c.gain['nominal']:.4g} → {c.gain['extended']:.4g}</td></tr>" for i, c in enumerate(dg.causes))
     alt = "".join(f"<li>{html.escape(a['name'])}: {html.escape(str(a['parameters']))} (absorbed by "
                   f"{html.escape(', '.join(a['absorbed_by']))})</li>" for a in dg.alternatives)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>hunting diagnosis</title></head><body>
 <h1>Diagnosis</h1>
-<p>Validation force-residual RMS: nominal {dg.nominal:.4g} N, extended {dg.extended:.4g} N.</p>
+<table border="1" cellpadding="4"><tr><th>validation metric</th><th>nominal</th><th>extended</th></tr>{gains}</table>
+{'<ul>' + notes + '</ul>' if notes else ''}
 <p>Criterion: {html.escape(dg.criterion)}.</p>
 <table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
 <th>validation RMS [N]</th></tr>{rows}</table>
 {'<h2>Alternatives</h2><ul>' + alt + '</ul>' if alt else ''}
-<img src="residual.png" width="720"></body></html>"""
+{''.join(f'<img src="{i}" width="720"><br>' for i in imgs)}</body></html>"""
     (d / "index.html").write_text(page)
     return d / "index.html"

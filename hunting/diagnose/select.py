@@ -20,7 +20,7 @@ re-simulated with the nominal and the extended model, compared with the measurem
 (:mod:`hunting.diagnose.behaviour`)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import stats
@@ -68,7 +68,8 @@ class Diagnosis:
     ones are in (their stand-alone parameters and gain: e.g. a constant offset that a
     direction-dependent viscous term explains as well); extended_model : the nominal model with
     every selected extension; behaviour : the behaviour view on the validation data (None without
-    a controller or a reference); notes : what was skipped and why."""
+    a controller or a reference); notes : what was skipped and why; validation : the validation
+    Measurement used."""
 
     causes: list
     nominal: float | None
@@ -85,6 +86,7 @@ class Diagnosis:
     extended_model: NominalModel | None = None
     behaviour: dict | None = None
     notes: list = field(default_factory=list)
+    validation: Measurement | None = None
 
     def gains(self) -> list:
         """Validation metrics of the nominal against the extended model: force residual RMS [N],
@@ -162,11 +164,15 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     notes: list = []
     nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
+    # sliding samples: |v| above 2 % of the maximum and above the model's stick speed (creep in
+    # presliding is not sliding)
+    kf = replace(kf, moving=kf.moving & (np.abs(kf.v) > model.v_stick()))
+    kv = replace(kv, moving=kv.moving & (np.abs(kv.v) > model.v_stick()))
     if kf.moving.sum() >= 50 and kv.moving.sum() >= 50:
         fc = _force_channel(force_names, kf, kv, model, max_causes, min_gain, alpha)
     else:
-        notes.append("force channel skipped: fewer than 50 moving samples (|v| > 2 % of the maximum) in the fitting "
-                     "or validation data")
+        notes.append("force channel skipped: fewer than 50 sliding samples (|v| > 2 % of the maximum and > the "
+                     f"model's stick speed {model.v_stick():.3g} m/s) in the fitting or validation data")
         fc = dict(causes=[], nominal=None, extended=None, rejected=[], alternatives=[], model=model,
                   r_fit=nan_f, r_val_nom=nan_v, r_val_ext=nan_v)
     ext = fc["model"]
@@ -188,7 +194,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     elif behaviour:
         notes.append("behaviour view skipped: it needs the model's 'controller' and the reference q_ref in the data")
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
-                     fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes)
+                     fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate)
 
 
 def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
@@ -310,30 +316,35 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     if sum(b - a + 1 for a, b in segs) < 200:
         return None, None, model
     res = model.resolution if model.resolution is not None else resolution_of(fit.q)
-    chi2, p, r0 = mod.evidence(kf, model, segs, res)
-    if can_sim:
-        theta, _ = mod.fit_behaviour(fit, model)
-        ext = mod.extend(model, theta, {})
+    chi2, p, _ = mod.evidence(kf, model, segs, res)
 
+    def reject(gain=None, reason=None):
+        row = dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=gain)
+        return None, (row if reason is None else dict(row, reason=reason)), model
+    if p >= alpha:
+        return reject(reason="no motion beyond quantization and sensor noise where the model sticks")
+    theta = mod.fit_behaviour(fit, model)[0] if can_sim else mod.fit_quasistatic(kf, model, segs)
+    try:
+        ext = mod.extend(model, theta, {})
+    except SystemDefinitionError as exc:           # e.g. a negative fitted compliance
+        return reject(reason=f"the fitted extension is not physical: {exc}")
+    if can_sim:
         def err(m):
             sim = resimulate(val, m)
             return float(np.sqrt(np.mean((sim.q - val.q[:sim.q.size]) ** 2)))
         before, after = err(model), err(ext)
         metric = "re-simulated position RMS error [m], validation"
     else:
-        theta = mod.fit_quasistatic(kf, model, segs)
-        ext = mod.extend(model, theta, {})
         sv = mod.segments(kv, model)
         if sum(b - a + 1 for a, b in sv) < 50:
-            return None, dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=None,
-                              reason="no stick segments in the validation data"), model
+            return reject(reason="no stick segments in the validation data")
         d, W, ids = mod.regressors(kv, model, sv)
         dm = lambda x: x - (np.bincount(ids, x) / np.bincount(ids))[ids]  # noqa: E731
         before, after = _rms(dm(d)), _rms(dm(d - W @ theta))
         metric = "stick-segment displacement RMS [m], validation"
     gain = 1 - after / max(before, 1e-300)
-    if not (p < alpha and gain >= min_gain):
-        return None, dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=gain), model
+    if gain < min_gain:
+        return reject(gain)
     pars = mod.parameters(theta, {}, model)
-    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, {k: float("nan") for k in pars},
+    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, {k: None for k in pars},
                   dict(metric=metric, nominal=before, extended=after), {}, np.asarray(theta)), None, ext)

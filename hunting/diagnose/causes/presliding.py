@@ -38,12 +38,10 @@ def friction_force(kin, model) -> np.ndarray:
 
 
 def v_stick(kin, model) -> float:
-    """Speed [m/s] below which the nominal model's mass counts as stuck: a tenth of the smaller
-    Stribeck velocity, or 2 % of the largest measured speed for curves without one."""
-    pos, neg = model.curve.positive, model.curve.negative
-    if pos.Fs > pos.Fc or neg.Fs > neg.Fc:
-        return 0.1 * min(pos.vs, neg.vs)
-    return 0.02 * float(np.max(np.abs(kin.v)))
+    """Speed [m/s] below which the nominal model's mass counts as stuck: the model's own
+    (:meth:`NominalModel.v_stick`), or 2 % of the largest measured speed for curves without a
+    Stribeck velocity."""
+    return model.v_stick() or 0.02 * float(np.max(np.abs(kin.v)))
 
 
 def segments(kin, model, *, min_time: float = 0.05) -> list[tuple[int, int]]:
@@ -104,7 +102,7 @@ def fit_quasistatic(kin, model, segs) -> np.ndarray:
     return th[:1]
 
 
-def fit_behaviour(meas, model, *, max_evals: int = 24) -> tuple[np.ndarray, float]:
+def fit_behaviour(meas, model, *, max_evals: int = 14) -> tuple[np.ndarray, float]:
     """theta = [1 / sigma0] minimizing the position RMS error of the re-simulated LuGre loop on
     ``meas`` (golden section on log10 sigma0 in [3, 9], bounded by max_evals re-simulations).
     Returns (theta, the RMS error [m])."""

@@ -1,0 +1,97 @@
+"""Re-simulation engine of the behaviour view, checked against independent solutions: the exact
+zero-order-hold discretization of a linear loop, the analytic stop of a mass under Coulomb
+friction, and the virtual linear motor's own sampled simulator (LuGre, cogging); and the
+behaviour metrics on signals with known answers."""
+import numpy as np
+import pytest
+from scipy.signal import cont2discrete
+
+from hunting.diagnose import NominalModel
+from hunting.diagnose.behaviour import behaviour, stick_phases
+from hunting.diagnose.data import Measurement
+from hunting.diagnose.resimulate import SampledController, resimulate
+from hunting.errors import SystemDefinitionError
+
+
+def _meas(n, dt, r, f_ext=None):
+    t = np.arange(n) * dt
+    return Measurement(t, np.full(n, r[0]), np.zeros(n), q_ref=r, f_ext=f_ext)
+
+
+def test_linear_loop_matches_exact_zoh_discretization():
+    m, cm, b, kp, kv, dt, n = 2.0, 3.0, 10.0, 40.0, 5.0, 1e-3, 3000
+    t = np.arange(n) * dt
+    r = 0.01 * np.sin(2 * np.pi * 1.3 * t) + 0.005 * (t > 1)
+    model = NominalModel.from_dict({"plant": {"mass": m, "motor_constant": cm}, "friction": {"Fc": 0.0, "b": b},
+                                    "controller": {"type": "pd-velocity-loop", "kp": kp, "kv": kv}})
+    sim = resimulate(_meas(n, dt, r), model, resolution=0.0)
+    A = np.array([[0, 1], [0, -b / m]])
+    B = np.array([[0], [cm / m]])
+    Ad, Bd, *_ = cont2discrete((A, B, np.eye(2), np.zeros((2, 1))), dt, method="zoh")
+    x, q_prev, qf_prev, qs = np.zeros(2), 0.0, 0.0, []
+    for k in range(n):
+        y = x[0]
+        qf = 0.5 * y + 0.5 * q_prev
+        u = kv * (kp * (r[k] - y) - (qf - qf_prev) / dt)
+        qf_prev, q_prev = qf, y
+        qs.append(y)
+        x = Ad @ x + Bd[:, 0] * u
+    assert np.max(np.abs(sim.q - qs)) < 1e-8 * 0.017 * 100
+
+
+def test_coulomb_stop_and_stick_are_exact():
+    """Pushed by 8 N for 0.5 s, then 2 N < Fc = 5 N: decelerates at 3 m/s^2, stops at t = 1 s
+    at q = 0.75 m and stays."""
+    n, dt = 3000, 1e-3
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 5.0},
+                                    "controller": {"type": "pid", "kp": 0.0}})
+    t = np.arange(n) * dt
+    sim = resimulate(_meas(n, dt, np.zeros(n), np.where(t < 0.5, 8.0, 2.0)), model, resolution=0.0)
+    k = 600 + int(np.argmax(sim.stuck[600:]))
+    assert t[k] == pytest.approx(1.0, abs=1.5 * dt)
+    assert sim.q[-1] == pytest.approx(0.75, abs=1e-9)
+    assert np.all(sim.stuck[k:])
+
+
+def test_lugre_loop_matches_the_virtual_motor():
+    from hunting.experiment.limms import Q_D, regulator
+    from hunting.experiment.motor import VirtualMotor
+    from hunting.experiment.sampled import run
+    from hunting.models.friction import DirectionalCurve
+    mot = VirtualMotor(noise=0.0, substeps=20)
+    rec = run(mot, regulator(10.0), 5 * 5000, reference=Q_D, x0=(Q_D + 0.01, 0.0, 0.0))
+    model = NominalModel(mot.mass, mot.cm, DirectionalCurve(mot.positive, mot.negative), "lugre", sigma0=mot.sigma0,
+                         sigma1=mot.sigma1, cogging=(mot.cogging_table(2e-6),),
+                         controller={"type": "pid", "form": "K", "K": 10.0})
+    sim = resimulate(Measurement(rec.t, rec.y, rec.u, q_ref=rec.r), model, substeps=40, x0=(Q_D + 0.01, 0.0, 0.0))
+    assert np.ptp(rec.y) > 0.03                      # it hunts over centimetres ...
+    assert np.max(np.abs(sim.q - rec.y)) <= 1.01e-6  # ... and agrees within one encoder count
+
+
+def test_controller_schema_forms_agree_and_errors_name_the_key():
+    K = SampledController.from_schema({"type": "pid", "form": "K", "K": 10.0, "tau_d": 0.2, "tau_i": 0.5})
+    P = SampledController.from_schema({"type": "pid", "form": "PDI", "P": 14.0, "D": 2 / 14, "I": 20 / 14})
+    assert (K.kp, K.kd, K.ki) == pytest.approx((P.kp, P.kd, P.ki))
+    with pytest.raises(SystemDefinitionError, match="unknown keys"):
+        SampledController.from_schema({"type": "pid", "Kp": 1.0})
+    with pytest.raises(SystemDefinitionError, match="derivative_on"):
+        SampledController.from_schema({"type": "pid", "kp": 1.0, "derivative_on": "both"})
+    with pytest.raises(SystemDefinitionError, match="sample_time"):
+        SampledController.from_schema({"type": "pid", "kp": 1.0, "sample_time": 1.5e-3}).array(1e-3)
+    m = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 1.0}})
+    with pytest.raises(SystemDefinitionError, match="controller"):
+        resimulate(_meas(100, 1e-3, np.zeros(100)), m)
+
+
+def test_behaviour_of_known_signals():
+    dt, res = 1e-3, 1e-6
+    t = np.arange(4000) * dt
+    # hunting: the error jumps between +1 mm and -1 mm every 0.4 s and sticks in between
+    q = np.where((t // 0.4) % 2 == 0, 1e-3, -1e-3)
+    b = behaviour(t, q, np.zeros_like(t), res)
+    assert b.sticks == 10 and b.stick_time == pytest.approx(0.4, abs=2 * dt)
+    assert b.stick_error == pytest.approx(1e-3) and b.cycle_amplitude == pytest.approx(1e-3)
+    assert b.cycle_period == pytest.approx(0.8, abs=2 * dt) and b.at_rest is False
+    rest = behaviour(t, np.full_like(t, 3e-6), np.zeros_like(t), res)
+    assert rest.at_rest is True and rest.cycle_period is None and rest.final_error == pytest.approx(3e-6)
+    assert stick_phases(q, dt, res, moved=5e-3) == [(0, 399)]     # the others are within 2 mm of it
