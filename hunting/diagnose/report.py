@@ -44,21 +44,25 @@ def residual_figure(dg: Diagnosis, path) -> None:
 
 
 def behaviour_figure(dg: Diagnosis, validate, path) -> None:
-    """Validation run: measured position error against the re-simulated nominal and extended
-    loops (the behaviour view)."""
+    """Validation run: the measured position error and the re-simulated nominal and extended
+    loops (top), and each simulation's deviation from the measurement (bottom)."""
     from .resimulate import resimulate
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(8, 4))
-    ax.plot(validate.t, validate.q - validate.q_ref, "k-", lw=1.0, label="measured")
+    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    axes[0].plot(validate.t, validate.q - validate.q_ref, "k-", lw=1.0, label="measured")
     for model, style, lab in ((dg.model, "C3--", "nominal"), (dg.extended_model, "C0-", "extended")):
         sim = resimulate(validate, model)
-        ax.plot(sim.t, sim.q - validate.q_ref[:sim.q.size], style, lw=0.8,
-                label=f"{lab} (RMS error {dg.behaviour[lab]['position_rms']:.3g} m)")
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("position error q - q_ref [m]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title("behaviour on the validation data: re-simulated closed loop", fontsize=10)
+        n = sim.q.size
+        axes[0].plot(sim.t, sim.q - validate.q_ref[:n], style, lw=0.8, label=lab)
+        axes[1].plot(sim.t, sim.q - validate.q[:n], style, lw=0.8,
+                     label=f"{lab} (RMS {dg.behaviour[lab]['position_rms']:.3g} m)")
+    axes[0].set_ylabel("q - q_ref [m]")
+    axes[1].set_ylabel("simulated - measured q [m]")
+    axes[1].set_xlabel("t [s]")
+    for a in axes:
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    axes[0].set_title("behaviour on the validation data: re-simulated closed loop", fontsize=10)
     fig.tight_layout()
     save(fig, path)
 
