@@ -90,11 +90,7 @@ def plot_hysteresis(force, displacement, *, title: str = "", path=None, units=("
     ax.set_ylabel(f"applied force [{units[0]}]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    if title:
-        ax.set_title(title)
-    fig.tight_layout()
-    if path is not None:
-        save(fig, path)
+    _finish(fig, ax, True, title, path)
     return fig
 
 
@@ -234,11 +230,7 @@ def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "r
     axm.set_ylabel("Floquet multipliers (real)")
     axm.grid(alpha=0.3)
     axm.legend(fontsize=8, ncol=4)
-    if title:
-        ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    if path is not None:
-        save(fig, path)
+    _finish(fig, ax, True, title, path)
     return fig
 
 
@@ -258,11 +250,7 @@ def plot_cycles(system, orbits, labels, *, title: str = "", path=None, eq_bounds
     ax.set_ylabel("x2")
     ax.set_zlabel("x3")
     ax.legend(fontsize=8)
-    if title:
-        ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    if path is not None:
-        save(fig, path)
+    _finish(fig, ax, True, title, path)
     return fig
 
 
@@ -281,11 +269,7 @@ def plot_frf(curves, *, title: str = "", path=None, unit: str = ""):
     for a in (a1, a2):
         a.grid(alpha=0.3, which="both")
     a1.legend(fontsize=8)
-    if title:
-        a1.set_title(title, fontsize=10)
-    fig.tight_layout()
-    if path is not None:
-        save(fig, path)
+    _finish(fig, a1, True, title, path)
     return fig
 
 

@@ -36,7 +36,7 @@ def test_linear_loop_matches_exact_zoh_discretization():
         qf_prev, q_prev = qf, y
         qs.append(y)
         x = Ad @ x + Bd[:, 0] * u
-    assert np.max(np.abs(sim.q - qs)) < 1e-8 * 0.017 * 100
+    assert np.max(np.abs(sim.q - qs)) < 1e-6 * np.max(np.abs(qs))      # RK4 substeps: 1.7e-8 relative
 
 
 def test_coulomb_stop_and_stick_are_exact():
@@ -95,3 +95,16 @@ def test_behaviour_of_known_signals():
     rest = behaviour(t, np.full_like(t, 3e-6), np.zeros_like(t), res)
     assert rest.at_rest is True and rest.cycle_period is None and rest.final_error == pytest.approx(3e-6)
     assert stick_phases(q, dt, res, moved=5e-3) == [(0, 399)]     # the others are within 2 mm of it
+
+
+def test_vectorized_cogging_matches_the_kernel_formula():
+    from hunting.models.plant import Cogging, cogging_force
+    rng = np.random.default_rng(0)
+    q = rng.uniform(-0.05, 0.05, 300)
+    for c in (Cogging.harmonic(0.013, [1.0, -0.3, 0.2], [0.5, 0.1]),
+              Cogging.table(np.linspace(-0.03, 0.03, 41), rng.normal(size=41))):
+        enc = c.encoded()
+        assert np.allclose(c(q), [cogging_force(v, enc, 0) for v in q], rtol=0, atol=1e-12)
+    m = NominalModel.from_dict({"plant": {"mass": 1.0, "cogging": {"pitch": 0.01, "cos": [1.0], "sin": [2.0]}},
+                                "friction": {"Fc": 1.0}})
+    assert m.cogging_force(np.array([0.0025])) == pytest.approx([2.0])      # 1 cos(pi/2) + 2 sin(pi/2)

@@ -95,16 +95,7 @@ class NominalModel:
     def cogging_force(self, q) -> np.ndarray:
         """F_cog(q) [N]: the sum of the components (0 without cogging)."""
         q = np.asarray(q, dtype=float)
-        out = np.zeros_like(q)
-        for c in self.cogging:
-            d = np.asarray(c.data)
-            if c.kind == COG_TABLE:
-                out += np.interp(q, d[:c.n], d[c.n:])
-                continue
-            for k in range(c.n):
-                w = 2 * np.pi * (k + 1) / c.period
-                out += d[2 * k] * np.cos(w * q) + d[2 * k + 1] * np.sin(w * q)
-        return out
+        return sum((c(q).reshape(q.shape) for c in self.cogging), np.zeros_like(q))
 
     def replace(self, **changes) -> "NominalModel":
         """A copy with fields changed (an extended model); ``source`` is rebuilt from it."""

@@ -46,12 +46,11 @@ def residual_figure(dg: Diagnosis, path) -> None:
 def behaviour_figure(dg: Diagnosis, validate, path) -> None:
     """Validation run: the measured position error and the re-simulated nominal and extended
     loops (top), and each simulation's deviation from the measurement (bottom)."""
-    from .resimulate import resimulate
     plt = _plt()
     fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     axes[0].plot(validate.t, validate.q - validate.q_ref, "k-", lw=1.0, label="measured")
-    for model, style, lab in ((dg.model, "C3--", "nominal"), (dg.extended_model, "C0-", "extended")):
-        sim = resimulate(validate, model)
+    for style, lab in (("C3--", "nominal"), ("C0-", "extended")):
+        sim = dg.simulations[lab]
         n = sim.q.size
         axes[0].plot(sim.t, sim.q - validate.q_ref[:n], style, lw=0.8, label=lab)
         axes[1].plot(sim.t, sim.q - validate.q[:n], style, lw=0.8,

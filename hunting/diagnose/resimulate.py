@@ -130,6 +130,17 @@ def _rates(q, v, z, s, fa, p, cog, bases):
     return v, (fd - F) / p[0], 0.0
 
 
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def _rk4(q, v, z, s, fa, h, p, cog, bases):
+    """One classical RK4 step of length h with the friction direction s held."""
+    a1, b1, c1 = _rates(q, v, z, s, fa, p, cog, bases)
+    a2, b2, c2 = _rates(q + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, s, fa, p, cog, bases)
+    a3, b3, c3 = _rates(q + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, s, fa, p, cog, bases)
+    a4, b4, c4 = _rates(q + h * a3, v + h * b3, z + h * c3, s, fa, p, cog, bases)
+    return (q + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4), v + h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4),
+            z + h / 6.0 * (c1 + 2 * c2 + 2 * c3 + c4))
+
+
 @numba.njit(cache=True, error_model="numpy", nogil=True)
 def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
           v_out, stuck_out):
@@ -172,14 +183,7 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
             ua = u_init if j < 0 else u_out[j // substeps]
             fa = p[1] * ua + fext[k] - p[2]
             if lugre:
-                s = 1.0 if v >= 0.0 else -1.0
-                a1, b1, c1 = _rates(q, v, z, s, fa, p, cog, bases)
-                a2, b2, c2 = _rates(q + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, s, fa, p, cog, bases)
-                a3, b3, c3 = _rates(q + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, s, fa, p, cog, bases)
-                a4, b4, c4 = _rates(q + h * a3, v + h * b3, z + h * c3, s, fa, p, cog, bases)
-                q += h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-                v += h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
-                z += h / 6.0 * (c1 + 2 * c2 + 2 * c3 + c4)
+                q, v, z = _rk4(q, v, z, 1.0 if v >= 0.0 else -1.0, fa, h, p, cog, bases)
                 continue
             rem = h
             for _ in range(3):             # a substep holds at most a stop and a restart
@@ -191,12 +195,7 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                     s = 1.0 if need > 0.0 else -1.0
                 else:
                     s = 1.0 if v > 0.0 else -1.0
-                a1, b1, _ = _rates(q, v, 0.0, s, fa, p, cog, bases)
-                a2, b2, _ = _rates(q + 0.5 * rem * a1, v + 0.5 * rem * b1, 0.0, s, fa, p, cog, bases)
-                a3, b3, _ = _rates(q + 0.5 * rem * a2, v + 0.5 * rem * b2, 0.0, s, fa, p, cog, bases)
-                a4, b4, _ = _rates(q + rem * a3, v + rem * b3, 0.0, s, fa, p, cog, bases)
-                qn = q + rem / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-                vn = v + rem / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+                qn, vn, _ = _rk4(q, v, 0.0, s, fa, rem, p, cog, bases)
                 if s * vn > 0.0:
                     q, v = qn, vn
                     break

@@ -69,7 +69,7 @@ class Diagnosis:
     direction-dependent viscous term explains as well); extended_model : the nominal model with
     every selected extension; behaviour : the behaviour view on the validation data (None without
     a controller or a reference); notes : what was skipped and why; validation : the validation
-    Measurement used."""
+    Measurement used; simulations : the behaviour view's re-simulations {"nominal", "extended"}."""
 
     causes: list
     nominal: float | None
@@ -87,6 +87,7 @@ class Diagnosis:
     behaviour: dict | None = None
     notes: list = field(default_factory=list)
     validation: Measurement | None = None
+    simulations: dict | None = None
 
     def gains(self) -> list:
         """Validation metrics of the nominal against the extended model: force residual RMS [N],
@@ -184,17 +185,17 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             result.append(cause)
         elif row is not None:
             rejected.append(row)
-    view = None
+    view, sims = None, None
     if behaviour and model.controller is not None and validate.q_ref is not None:
         from .behaviour import compare
         from .resimulate import resimulate, resolution_of
         res = model.resolution if model.resolution is not None else resolution_of(validate.q)
-        view = compare(validate, {"nominal": resimulate(validate, model), "extended": resimulate(validate, ext)},
-                       model.cm, res)
+        sims = {"nominal": resimulate(validate, model), "extended": resimulate(validate, ext)}
+        view = compare(validate, sims, model.cm, res)
     elif behaviour:
         notes.append("behaviour view skipped: it needs the model's 'controller' and the reference q_ref in the data")
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
-                     fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate)
+                     fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims)
 
 
 def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
@@ -316,7 +317,7 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     if sum(b - a + 1 for a, b in segs) < 200:
         return None, None, model
     res = model.resolution if model.resolution is not None else resolution_of(fit.q)
-    chi2, p, _ = mod.evidence(kf, model, segs, res)
+    chi2, p = mod.evidence(kf, model, segs, res)
 
     def reject(gain=None, reason=None):
         row = dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=gain)
@@ -338,9 +339,7 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
         sv = mod.segments(kv, model)
         if sum(b - a + 1 for a, b in sv) < 50:
             return reject(reason="no stick segments in the validation data")
-        d, W, ids = mod.regressors(kv, model, sv)
-        dm = lambda x: x - (np.bincount(ids, x) / np.bincount(ids))[ids]  # noqa: E731
-        before, after = _rms(dm(d)), _rms(dm(d - W @ theta))
+        before, after = mod.displacement_rms(kv, model, sv, theta)
         metric = "stick-segment displacement RMS [m], validation"
     gain = 1 - after / max(before, 1e-300)
     if gain < min_gain:

@@ -9,7 +9,7 @@ saturation at 10 V) tracks bang-bang strokes; the encoder quantizes q. The loop 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -39,7 +39,6 @@ class TruePlant:
     fs: float = 1000.0
     resolution: float = 1e-6
     force_noise: float = 0.5
-    extra: dict = field(default_factory=dict)
 
 
 def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0) -> np.ndarray:

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..diagnose.behaviour import stick_phases as _stick_phases
 from ..errors import SystemDefinitionError
 from ..identify import (cogging_table, curve_from_fit, estimate_frf, fit_double_integrator, fit_second_order,
                         fit_stribeck)
@@ -196,8 +197,7 @@ def stick_phases(rec: Record, resolution: float, *, window: float = 0.03, counts
     mass creeps through while the integral action loads the bristles).
     Returns (first, last) sample indices. (With presliding there is no exact stick; the thesis
     decides it by inspection.)"""
-    from ..diagnose.behaviour import stick_phases as phases
-    return phases(rec.y, float(rec.t[1] - rec.t[0]), resolution, window=window, counts=counts, moved=moved,
+    return _stick_phases(rec.y, float(rec.t[1] - rec.t[0]), resolution, window=window, counts=counts, moved=moved,
                   origin=float(rec.y[0]))
 
 

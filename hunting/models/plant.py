@@ -146,10 +146,17 @@ class Cogging:
         return np.array([self.kind, self.n, self.period, *self.data], dtype=float)
 
     def __call__(self, q) -> np.ndarray:
-        """F_cog at positions q (array) [N]."""
-        enc = self.encoded()
+        """F_cog at positions q (array) [N]: the formula of :func:`cogging_force`, vectorized."""
         qa = np.atleast_1d(np.asarray(q, dtype=float))
-        return np.array([cogging_force(float(v), enc, 0) for v in qa.reshape(-1)]).reshape(qa.shape)
+        d = np.asarray(self.data, dtype=float)
+        if self.kind == COG_TABLE:
+            return np.interp(qa, d[:self.n], d[self.n:])          # held constant outside, as in the kernel
+        out = np.zeros_like(qa)
+        if self.kind == COG_HARMONIC:
+            w = 2.0 * np.pi / self.period
+            for k in range(self.n):
+                out += d[2 * k] * np.cos(w * (k + 1) * qa) + d[2 * k + 1] * np.sin(w * (k + 1) * qa)
+        return out
 
     def slope(self, q, dq: float = 1e-7) -> np.ndarray:
         """dF_cog/dq [N/m] by central differences (exact for tables away from nodes)."""

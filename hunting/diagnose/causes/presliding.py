@@ -83,23 +83,37 @@ def regressors(kin, model, segs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.concatenate(ds), np.concatenate(ws)[:, None], np.concatenate(ids)
 
 
-def evidence(kin, model, segs, resolution: float) -> tuple[float, float, np.ndarray]:
-    """(chi-square statistic, p-value, demeaned displacement (m,)) of the stick segments."""
+def _demean(x: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """x minus its mean over each segment (the free per-segment offsets), along axis 0."""
+    counts = np.bincount(ids)
+    if x.ndim == 1:
+        return x - (np.bincount(ids, x) / counts)[ids]
+    return np.column_stack([_demean(x[:, j], ids) for j in range(x.shape[1])])
+
+
+def evidence(kin, model, segs, resolution: float) -> tuple[float, float]:
+    """(chi-square statistic, p-value) of the motion in the stick segments."""
     from scipy import stats
     d, _, ids = regressors(kin, model, segs)
-    r0 = d - (np.bincount(ids, d) / np.bincount(ids))[ids]
     var = resolution ** 2 / 4 + model.sensor_noise ** 2
-    dof = max(d.size - len(segs), 1)
-    chi2 = float(np.sum(r0 ** 2) / max(var, 1e-30))
-    return chi2, float(stats.chi2.sf(chi2, dof)), r0
+    chi2 = float(np.sum(_demean(d, ids) ** 2) / max(var, 1e-30))
+    return chi2, float(stats.chi2.sf(chi2, max(d.size - len(segs), 1)))
 
 
 def fit_quasistatic(kin, model, segs) -> np.ndarray:
     """theta = [1 / sigma0] by least squares on the stick segments (segment offsets free)."""
     d, W, ids = regressors(kin, model, segs)
-    A = np.column_stack([W, np.eye(len(segs))[ids]]) if len(segs) < 200 else W
-    th, *_ = np.linalg.lstsq(A, d, rcond=None)
-    return th[:1]
+    th, *_ = np.linalg.lstsq(_demean(W, ids), _demean(d, ids), rcond=None)
+    return th
+
+
+def displacement_rms(kin, model, segs, theta) -> tuple[float, float]:
+    """RMS [m] of the segment-demeaned displacement in the stick segments unexplained by the
+    nominal model (all of it) and by the quasi-static extension theta."""
+    d, W, ids = regressors(kin, model, segs)
+    r0 = _demean(d, ids)
+    r1 = r0 - _demean(W, ids) @ theta
+    return float(np.sqrt(np.mean(r0 ** 2))), float(np.sqrt(np.mean(r1 ** 2)))
 
 
 def fit_behaviour(meas, model, *, max_evals: int = 14) -> tuple[np.ndarray, float]:
