@@ -28,6 +28,32 @@ def test_monodromy_matches_finite_differences_of_the_flow(name, kw, x0, T, metho
     assert np.abs(fl.Phi - J).max() <= 1e-6 * np.abs(J).max()
 
 
+@pytest.mark.parametrize("name,kw,par,x0,T,method", [
+    ("table9.1", {}, "P", [0.1, -0.2, 0.03], 2.5, "dop853"),                 # stick exit moves with P
+    ("table9.1", dict(beta="inf"), "Fs", [0.1, -0.2, 0.03], 2.5, "dop853"),  # the jump in f moves with Fs
+    ("table9.1", dict(model="switch-banded", eta=1e-3), "P", [0.1, -0.2, 0.03], 2.5, "dop853"),
+    ("table8.1-lugre", {}, "K", [-0.02, 0.05, 0.01, 1e-5], 0.5, "dop853"),
+    ("table8.1-lugre", {}, "K", [-0.02, 0.05, 0.01, 1e-5], 0.5, "radau"),
+    ("limms-switch", {}, "K", [0.004, -0.05, 0.001], 4.0, "dop853"),
+])
+def test_parameter_sensitivity_matches_finite_differences(name, kw, par, x0, T, method):
+    """d x(T) / d mu from the variational column with forcing f_mu and the guards' and resets'
+    mu-derivatives at the events, against central differences of the flow in mu."""
+    from hunting.models.presets import resolve_parameters
+    mu = float(resolve_parameters(name, kw)[par])
+    at = lambda m: preset(name, **{**kw, par: m}).system                          # noqa: E731
+    h = 1e-6 * abs(mu)
+    dp = (at(mu + h).params - at(mu - h).params) / (2 * h)
+    fl = flow(at(mu), x0, T, method=method, rtol=1e-11, atol=1e-14, param_direction=dp)
+    assert fl.ok and len(fl.event_times) >= 2
+    hf = 1e-6 * abs(mu)
+    fd = (flow(at(mu + hf), x0, T, sensitivity=False, rtol=1e-12, atol=1e-15).x
+          - flow(at(mu - hf), x0, T, sensitivity=False, rtol=1e-12, atol=1e-15).x) / (2 * hf)
+    assert np.abs(fl.dx_dmu - fd).max() <= 1e-6 * np.abs(fd).max()
+    plain = flow(at(mu), x0, T, method=method, rtol=1e-11, atol=1e-14)
+    assert np.abs(fl.Phi - plain.Phi).max() <= 1e-6 * np.abs(plain.Phi).max()
+
+
 def test_stick_entry_projects_out_the_velocity():
     """Entering stick makes d x2 / d x0 vanish: a multiplier 0 (thesis chapter 8)."""
     sys_ = preset("table9.1").system

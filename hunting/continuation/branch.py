@@ -2,9 +2,12 @@
 
 Unknowns u = (x0 without the section component, T, mu), scaled by their magnitudes at the
 start. Predictor: the unit tangent (null vector of [F_z | F_mu], oriented along the previous
-one). Corrector: Newton on [F(u); t . (u - u_pred)] = 0 with the monodromy-based F_z and
-F_mu by central differences in mu. Step size grows after easy corrections and shrinks after
-failed ones. At every point: Floquet multipliers and stability. Special points: folds (mu
+one) with a quadratic term through the point before. Corrector: quasi-Newton on
+[F(u); t . (u - u_pred)] = 0 from the Jacobian extrapolated along the branch, Broyden updates
+and one flow without sensitivities per iteration; the Jacobian (monodromy-based F_z, F_mu from
+the flow's parameter-sensitivity column) is recomputed only when the residual stops
+contracting, and full Newton takes over where the quasi-Newton fails. Step size grows after
+easy corrections and shrinks after hard or failed ones and sharp turns of the tangent. At every point: Floquet multipliers and stability. Special points: folds (mu
 turns back; a multiplier passes +1) located by bisection in arclength, period doublings
 (a multiplier passes -1), tori (a complex pair leaves the unit circle) and "grazing": the
 event sequence of the orbit changes (a stick phase or a velocity reversal appears or vanishes),
@@ -29,20 +32,26 @@ class ContinuationOptions:
     """ds : first step (in scaled arclength); ds_min, ds_max : bounds; max_points : bound on
     branch points; newton_tol, newton_max : corrector; dmu : relative step of the central
     difference in the parameter; fold_tol : relative parameter width at which a fold stops
-    being refined; max_correction : largest corrector move as a fraction of ds and max_angle
-    [rad] the largest turn of the tangent in one step (larger ones halve ds: no branch jumping)."""
+    being refined; chord_rate : slowest contraction of the residual accepted with a kept
+    Jacobian (slower ones recompute it); max_correction : largest corrector move as a fraction of ds and max_angle
+    [rad] the largest turn of the tangent in one step (larger ones halve ds: no branch jumping);
+    jacobian_rtol : rtol of the flows with
+    sensitivities (monodromy matrix, d phi / d mu); the orbits themselves are as accurate as
+    the shooting options' rtol."""
 
     ds: float = 0.05
     ds_min: float = 1e-6
     ds_max: float = 0.3
     max_points: int = 400
     newton_tol: float = 1e-9
-    newton_max: int = 10
+    newton_max: int = 12
+    chord_rate: float = 0.6
     dmu: float = 1e-8
     fold_tol: float = 1e-7
     max_correction: float = 0.3
     step_tol: float = 1e-10
     max_angle: float = 0.15
+    jacobian_rtol: float = 1e-7
     quadratic_predictor: bool = True
 
     def __post_init__(self):
@@ -113,8 +122,17 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     scale = np.concatenate([np.maximum(np.abs(orbit.x0[free]), 1e-3 * np.max(np.abs(orbit.x0))),
                             [orbit.period, max(abs(mu0), 1e-6)]])
     lo, hi = sorted((mu0, mu_end))
-    kw = dict(method=sopt.method, rtol=sopt.rtol, atol=sopt.atol, max_events=sopt.max_events,
-              max_steps=sopt.max_steps)
+    # a residual flow's error must stay below the corrector's tolerance: rtol <= newton_tol / 100
+    rtol_res = min(sopt.rtol, 1e-2 * opt.newton_tol)
+    kw_res = dict(method=sopt.method, rtol=rtol_res, atol=rtol_res * sopt.atol / sopt.rtol,
+                  max_events=sopt.max_events, max_steps=sopt.max_steps)
+    # three accuracies: residual flows (no sensitivities) at rtol_res; the converged
+    # points' Jacobians (multipliers, tangent) at 100 rtol, which gives x as accurately because
+    # the error control then covers Phi too (measured on the chapter-8 cycles); the Jacobians
+    # recomputed inside the corrector only steer it, at jacobian_rtol
+    kw_point = dict(kw_res, rtol=100 * kw_res["rtol"], atol=100 * kw_res["atol"])
+    rtol_j = max(opt.jacobian_rtol, kw_point["rtol"])
+    kw = dict(kw_res, rtol=rtol_j, atol=rtol_j * kw_res["atol"] / kw_res["rtol"])
 
     def unpack(v):
         u = v * scale
@@ -123,32 +141,30 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         x[free] = u[:-2]
         return x, u[-2], u[-1]
 
-    def residual_and_jac(v, need_jac=True, Fmu=None):
-        """(r, J, flow) at v; J's parameter column d phi / d mu is recomputed unless given."""
+    def param_direction(mu):
+        """d params / d mu at mu (central differences of system_at: exact for the usual
+        parameters, which enter the array linearly)."""
+        h = 1e-6 * max(abs(mu), 1e-3)
+        return (system_at(mu + h).params - system_at(mu - h).params) / (2 * h)
+
+    def residual_and_jac(v, need_jac=True, precise=False):
+        """(r, J, flow) at v; J = [Phi - I without the section column | f | d phi / d mu],
+        the last column from the flow's parameter-sensitivity column; ``precise`` integrates
+        it at 100 times the orbits' rtol instead of jacobian_rtol."""
         x, T, mu = unpack(v)
         if not (np.isfinite(T) and T > 0 and np.all(np.isfinite(x)) and np.isfinite(mu)):
             return None                  # a diverging corrector: the caller halves the step
         sys_ = system_at(mu)
-        fl = flow(sys_, x, T, sensitivity=need_jac, **kw)
+        if need_jac:
+            fl = flow(sys_, x, T, param_direction=param_direction(mu), **(kw_point if precise else kw))
+        else:
+            fl = flow(sys_, x, T, sensitivity=False, **kw_res)
         if not fl.ok:
             return None
         r = fl.x - x
         if not need_jac:
             return r, None, fl
-        if Fmu is not None:
-            return r, np.column_stack([(fl.Phi - np.eye(n))[:, free], fl.f, Fmu]) * scale[None, :], fl
-        # d phi / d mu by central differences: it must be accurate to ~1e-7, because the
-        # extended system is as ill-conditioned as the orbit is unstable (a 1e-4 error in this
-        # column slowed Newton to a linear rate of 0.1 on the unstable branch); hence a small
-        # step and tight tolerances for these two flows
-        h = opt.dmu * max(abs(mu), 1e-3)
-        kw_mu = dict(kw, rtol=min(sopt.rtol, 1e-13), atol=min(sopt.atol, 1e-16))
-        fp = flow(system_at(mu + h), x, T, sensitivity=False, **kw_mu)
-        fm = flow(system_at(mu - h), x, T, sensitivity=False, **kw_mu)
-        if not (fp.ok and fm.ok):
-            return None
-        Fmu = (fp.x - fm.x) / (2 * h)
-        Jz = np.column_stack([(fl.Phi - np.eye(n))[:, free], fl.f, Fmu]) * scale[None, :]
+        Jz = np.column_stack([(fl.Phi - np.eye(n))[:, free], fl.f, fl.dx_dmu]) * scale[None, :]
         return r, Jz, fl
 
     def tangent(J, prev=None):
@@ -158,47 +174,67 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             t = -t
         return t / np.linalg.norm(t)
 
-    def correct(v_pred, t):
+    def iterate(v_pred, t, J0, newton):
+        """The corrector's iterations from v_pred: quasi-Newton from J0 (``newton`` False) or
+        Newton with J recomputed at every iterate. Returns (v, Jacobian evaluations) or None."""
         v = v_pred.copy()
+        Jq = J0
         res_prev = np.inf
+        r_prev = dv = None
+        refreshes = 0
         for k in range(opt.newton_max):
-            out = residual_and_jac(v)
+            out = residual_and_jac(v, need_jac=False)
             if out is None:
                 return None
-            r, J, fl = out
+            r = out[0]
             res = _scaled(r, unpack(v)[0])
             g = np.dot(t, v - v_pred)
             if res < opt.newton_tol and abs(g) < 1e-12:
-                return v, J, fl, k
-            A = np.vstack([J, t])
+                return v, refreshes
+            if newton or Jq is None or res > opt.chord_rate * res_prev:
+                if refreshes and res > res_prev:
+                    return None                  # diverging even with a fresh Jacobian
+                out = residual_and_jac(v, precise=newton)
+                if out is None:
+                    return None
+                Jq = out[1]
+                refreshes += 1
+            elif dv is not None:
+                # Broyden's rank-one update with the secant (dv, r - r_prev)
+                Jq = Jq + np.outer(r - r_prev - Jq @ dv, dv) / np.dot(dv, dv)
+            res_prev, r_prev = res, r
             try:
-                dv = np.linalg.solve(A, -np.append(r, g))
+                dv = np.linalg.solve(np.vstack([Jq, t]), -np.append(r, g))
             except np.linalg.LinAlgError:
                 return None
             v = v + dv
-            # converging fast (rate < 0.01) with a predicted next residual well below the
-            # tolerance: accept the step after one flow with sensitivities (for the monodromy
-            # matrix at the point), keeping the previous d phi / d mu (O(|dv|) away) instead
-            # of two more tight flows
-            rate = res / res_prev
-            res_prev = res
-            if k >= 1 and rate < 0.01 and res * rate < 0.1 * opt.newton_tol:
-                out = residual_and_jac(v, Fmu=J[:, -1] / scale[-1])
-                if out is None:
-                    return None
-                return v, out[1], out[2], k + 1
             # the residual of a strongly unstable orbit has a noise floor (integration error
             # amplified by its multiplier): a negligible Newton step also means convergence
             if np.linalg.norm(dv) < opt.step_tol and res < 1e3 * opt.newton_tol:
-                out = residual_and_jac(v)
-                if out is None:
-                    return None
-                return v, out[1], out[2], k + 1
-        out = residual_and_jac(v)
+                return v, refreshes
+        out = residual_and_jac(v, need_jac=False)
+        if out is None or _scaled(out[0], unpack(v)[0]) >= 10 * opt.newton_tol:
+            return None
+        return v, refreshes
+
+    def correct(v_pred, t, J0):
+        """Converge from the predictor onto the branch: quasi-Newton from J0 (the last point's
+        Jacobian) with Broyden updates, so an iteration costs one flow without sensitivities;
+        J is recomputed at the iterate when the residual contracts slower than ``chord_rate``.
+        Where that fails (sharp folds), Newton with a precise J at every iterate. The
+        converged point gets its own precise J: its monodromy matrix gives the
+        multipliers, its null vector the tangent whose parameter component locates folds.
+        Returns (v, J, flow, Jacobian evaluations) or None."""
+        it = iterate(v_pred, t, J0, newton=False)
+        if it is None:
+            it = iterate(v_pred, t, None, newton=True)
+            if it is None:
+                return None
+        v, refreshes = it
+        out = residual_and_jac(v, precise=True)
         if out is None:
             return None
-        r, J, fl = out
-        return (v, J, fl, opt.newton_max) if _scaled(r, unpack(v)[0]) < 10 * opt.newton_tol else None
+        return v, out[1], out[2], refreshes
 
     v = np.concatenate([orbit.x0[free], [orbit.period, mu0]]) / scale
     out = residual_and_jac(v)
@@ -209,6 +245,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     if np.sign(t[-1]) != np.sign(mu_end - mu0):
         t = -t
     pts_v, pts_fl, tangents = [v], [fl], [t]
+    J_prev = None
     special: list[SpecialPoint] = []
     ds = opt.ds
     status, message = Status.SUCCESS, "reached the end of the parameter range"
@@ -227,7 +264,13 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
                 c = (chord + h * t) / h ** 2
                 if np.linalg.norm(c) * ds ** 2 < 0.5 * ds:
                     v_pred = v_pred + c * ds ** 2
-        res = correct(v_pred, t)
+        J_pred = J
+        if J_prev is not None and opt.quadratic_predictor:
+            # the Jacobian extrapolated along the branch like the point: its error at the
+            # predictor is O(ds^2) instead of O(ds), so the quasi-Newton corrector rarely
+            # needs to recompute it
+            J_pred = J + (J - J_prev) * (ds / float(np.linalg.norm(v - pts_v[-2])))
+        res = correct(v_pred, t, J_pred)
         if res is None:
             ds *= 0.5
             if ds < opt.ds_min:
@@ -235,7 +278,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
                                                          f"near {param} = {unpack(v)[2]:.6g}")
                 break
             continue
-        v_new, J_new, fl_new, iters = res
+        v_new, J_new, fl_new, refreshes = res
         t_new = tangent(J_new, t)
         # guard against jumping to a nearby branch: the corrector must stay close to the
         # predictor and the tangent must not turn too much in one step
@@ -244,16 +287,20 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             ds *= 0.5
             continue
         mu_new = unpack(v_new)[2]
+        # the next step from the corrector's work (a Jacobian recomputed more than once: the
+        # predictor was too far) and the tangent's turn (no more than half of max_angle)
+        turn = float(np.arccos(np.clip(np.dot(t_new, t), -1.0, 1.0)))
+        grow = min((1.4, 1.0, 0.7)[min(refreshes, 2)], 0.5 * opt.max_angle / max(turn, 1e-12))
         # fold: the parameter component of the tangent changes sign
         if np.sign(t_new[-1]) != np.sign(t[-1]):
-            sp = _refine_fold(correct, tangent, unpack, v, t, ds, opt, len(pts_v) - 1)
+            sp = _refine_fold(lambda vp, tp: correct(vp, tp, J), tangent, unpack, v, t, ds, opt, len(pts_v) - 1)
             special.append(sp)
             turns += 1
         if tuple(fl_new.modes) != tuple(fl.modes) and len(fl_new.modes) != len(fl.modes):
             special.append(SpecialPoint("grazing", len(pts_v) - 1, 0.5 * (unpack(v)[2] + mu_new),
                                         tuple(sorted((unpack(v)[2], mu_new))), abs(mu_new - unpack(v)[2]),
                                         {"events_before": len(fl.modes) - 1, "events_after": len(fl_new.modes) - 1}))
-        v, t, fl = v_new, t_new, fl_new
+        v, t, fl, J, J_prev = v_new, t_new, fl_new, J_new, J
         pts_v.append(v)
         pts_fl.append(fl)
         tangents.append(t)
@@ -263,10 +310,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             if (t[-1] < 0 and mu_new <= stop_at_mu) or (t[-1] > 0 and mu_new >= stop_at_mu):
                 message = f"stopped at {param} = {mu_new:.6g} after {turns} fold(s)"
                 break
-        if iters <= 4:
-            ds = min(opt.ds_max, ds * 1.4)
-        elif iters >= 7:
-            ds = max(opt.ds_min, ds * 0.6)
+        ds = float(np.clip(ds * grow, max(opt.ds_min, 0.5 * ds), opt.ds_max))
     # assemble
     mus, Ts, amps, lams, stab, xs, modes = [], [], [], [], [], [], []
     for vv, ff in zip(pts_v, pts_fl):

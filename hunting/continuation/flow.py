@@ -16,7 +16,8 @@ from ..system import PiecewiseSystem, no_jacobian
 @dataclass(frozen=True)
 class Flow:
     """x : (n,) state at T; Phi : (n, n) d x(T) / d x0; mode : mode at T; f : (n,) vector field at
-    x(T) in that mode; events : (k,) event times; modes : (k + 1,) mode sequence; status."""
+    x(T) in that mode; events : (k,) event times; modes : (k + 1,) mode sequence; status;
+    dx_dmu : (n,) d x(T) / d mu when a parameter direction was given."""
 
     x: np.ndarray
     Phi: np.ndarray
@@ -26,6 +27,7 @@ class Flow:
     modes: np.ndarray
     guards: np.ndarray
     status: Status
+    dx_dmu: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:
@@ -35,14 +37,30 @@ class Flow:
 def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, params=None,
          method: str = "dop853", rtol: float = 1e-11, atol: float = 1e-13, sensitivity: bool = True,
          max_steps: int = 500_000, max_events: int = 10_000, guard_tol: float = 1e-12,
-         stop_mode: int = -1, stop_count: int = 1) -> Flow:
-    """Integrate over [0, T] (or until the stop condition) with the fundamental matrix Phi."""
+         stop_mode: int = -1, stop_count: int = 1, param_direction=None) -> Flow:
+    """Integrate over [0, T] (or until the stop condition) with the fundamental matrix Phi.
+
+    param_direction : (len(params),) d params / d mu of a scalar parameter mu: the parameter
+    sensitivity d x(T) / d mu is integrated with Phi (variational column with forcing f_mu,
+    event terms from the guards' and transitions' mu-derivatives) and returned as dx_dmu."""
     x0 = system.check_state(x0)
     if not (np.isfinite(T) and T > 0):
         raise SystemDefinitionError(f"T = {T!r} is not allowed: the period must be a finite number > 0")
     n = system.n_states
     p = system.params if params is None else np.ascontiguousarray(params, dtype=np.float64)
-    y0 = np.concatenate([x0, np.eye(n).ravel()]) if sensitivity else x0.copy()
+    p = p.copy()                                  # the kernel perturbs p in place for f_mu
+    dpw = K.NO_PARAM_DIRECTION
+    m = n
+    if param_direction is not None:
+        dp = np.asarray(param_direction, dtype=np.float64)
+        if dp.shape != p.shape or not np.all(np.isfinite(dp)) or not np.any(dp):
+            raise SystemDefinitionError(f"param_direction has shape {dp.shape} or is zero/non-finite: it must be a "
+                                        f"finite, non-zero array of shape {p.shape} (d params / d mu)")
+        if not sensitivity:
+            raise SystemDefinitionError("param_direction needs sensitivity=True")
+        dpw = np.vstack([dp, np.zeros_like(dp)])
+        m = n + 1
+    y0 = np.concatenate([x0, np.eye(n, m).ravel()]) if sensitivity else x0.copy()
     N = y0.size
     out_t, out_x, out_m = np.empty(1), np.empty((1, N)), np.empty(1, dtype=np.int64)
     cap = max_events + 1
@@ -55,7 +73,7 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
     nf, ni = K.workspace_sizes(N, n, system.n_guards, system.n_modes, 50)
     K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
                        system.jacobian is not None, METHODS[method], n, 0.0, float(T), y0,
-                       -1 if mode0 is None else int(mode0), p, system.directions, rtol, atol, 0.0, np.inf,
+                       -1 if mode0 is None else int(mode0), p, dpw, system.directions, rtol, atol, 0.0, np.inf,
                        int(max_steps), int(max_events), guard_tol, False, np.empty(0), False, int(stop_mode),
                        int(stop_count), 50, 1e-12 * T, out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f,
                        ev_to, info, finfo, yf, np.empty(nf), np.empty(ni, dtype=np.int64))
@@ -70,9 +88,10 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
         system.vector_field(mode, float(finfo[K.F_T]), x, p, f)
     else:
         f[:] = np.nan
-    Phi = yf[n:].reshape(n, n).copy() if sensitivity else np.full((n, n), np.nan)
+    Phim = yf[n:].reshape(n, m) if sensitivity else np.full((n, m), np.nan)
     modes = np.concatenate([[ev_f[0]] if nev else [mode], ev_to[:nev]])
-    return Flow(x, Phi, mode, f, ev_t[:nev].copy(), modes, ev_g[:nev].copy(), st)
+    return Flow(x, Phim[:, :n].copy(), mode, f, ev_t[:nev].copy(), modes, ev_g[:nev].copy(), st,
+                Phim[:, n].copy() if m > n else None)
 
 
 def fd_jacobian(system, x0, T, *, mode0=None, rel: float = 1e-6, **kw) -> np.ndarray:

@@ -49,13 +49,14 @@ def find_cycle(name: str, overrides: dict | None = None, *, which: str = "stable
 
 def follow(name: str, param: str, start: float, end: float, *, overrides: dict | None = None,
            stop_at: float | None = None, options: ContinuationOptions | None = None,
-           shooting: ShootingOptions | None = None) -> Branch:
+           shooting: ShootingOptions | None = None, orbit: PeriodicOrbit | None = None) -> Branch:
     """The hunting branch of a preset from ``param = start`` towards ``end``; after a fold the
-    branch is followed back until ``param`` reaches ``stop_at`` (default: ``start``)."""
+    branch is followed back until ``param`` reaches ``stop_at`` (default: ``start``). ``orbit``:
+    the cycle at ``start`` when already known (else find_cycle finds the stable one)."""
     if name not in PRESETS:
         raise SystemDefinitionError(f"preset = {name!r} is not known: presets are {sorted(PRESETS)}")
     overrides = dict(overrides or {})
-    po = find_cycle(name, {**overrides, param: start}, shooting=shooting)
+    po = orbit if orbit is not None else find_cycle(name, {**overrides, param: start}, shooting=shooting)
     base = preset(name, **{**overrides, param: start}).system
 
     def system_at(mu):

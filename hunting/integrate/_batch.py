@@ -63,7 +63,7 @@ def batch_kernel(vf, guards, reset, jac, mode_of, has_jac, method,
         xf = np.empty(n)
         te = np.empty(0)
         K.integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, n, 0.0, t_max,
-                           np.ascontiguousarray(X0[k]), mode0[k], p_k, dir_k, rtol, atol[k], 0.0,
+                           np.ascontiguousarray(X0[k]), mode0[k], p_k, np.empty((0, 0)), dir_k, rtol, atol[k], 0.0,
                            np.inf, max_steps, max_events, guard_tol[k], False, te, False, stop_mode,
                            stop_count, 50, 1e-10, out_t, out_x, out_m,
                            ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo, xf, wf, wi)

@@ -18,7 +18,7 @@ from numba import types
 
 from ..errors import Status
 from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE
-from ._rhs import jacobian_central_or_exact, rhs
+from ._rhs import jacobian_central_or_exact, param_step, rhs
 from ._steppers import (EPS, dense_eval, explicit_dense, explicit_step, numerical_jacobian,
                         radau_dense, radau_step, select_initial_step)
 from ._tableau import METHOD_DOP853, METHOD_DP5, METHOD_RADAU
@@ -32,6 +32,8 @@ ROOT_MAXITER = 200
 # info[] slots (int64)
 I_STATUS, I_NOUT, I_NEV, I_NSTEPS, I_NREJ, I_NFEV, I_MODE, I_STOPHITS, I_IEVAL, I_NJAC, I_NEVTOT = range(11)
 N_INFO = 11
+# dpw argument of a run without a parameter-sensitivity column
+NO_PARAM_DIRECTION = np.empty((0, 0))
 # finfo[] slots (float64)
 F_T, F_H = range(2)
 N_FINFO = 2
@@ -170,20 +172,20 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr,
+def _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr,
              Z, F3, R, K, ytmp, y_new, f_new, err):
     """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
     if method == METHOD_RADAU:
-        en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, he, p, rtol, atol, J, M, piv,
+        en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, J, M, piv,
                                   Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
         return conv, fe
-    explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new,
+    explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new,
                   f_new, err)
     return True, 12 if method == METHOD_DOP853 else 6
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol,
+def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol,
                   J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, xb, gs):
     """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
     On success xs holds the state at the returned event time; otherwise xs is left as the
@@ -200,7 +202,7 @@ def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, guards, method, mode
     he = t_ev - t
     nfev = 0
     for it in range(4):
-        ok, fe = _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv,
+        ok, fe = _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv,
                           Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err)
         nfev += fe
         if not ok:
@@ -226,7 +228,8 @@ def saltation(vf, guards, reset, mode_old, mode_new, i_ev, t, xm, xp, p, S, fm, 
 
     with f- the old mode's field at x-, f+ the new mode's at x+, n = grad h and R_x by central
     differences (guards and resets are cheap; for the usual linear guards and resets the
-    differences are exact). Returns n . f- + h_t (near 0: grazing)."""
+    differences are exact). Returns n . f- + h_t (near 0: grazing); leaves the jump
+    (f+ - R_x f-) / (n . f- + h_t) in fp."""
     nb = xm.size
     vf(mode_old, t, xm, p, fm)
     vf(mode_new, t, xp, p, fp)
@@ -261,15 +264,40 @@ def saltation(vf, guards, reset, mode_old, mode_new, i_ev, t, xm, xp, p, S, fm, 
         for k in range(nb):
             acc += Rx[i, k] * fm[k]
         jump = (fp[i] - acc) / den
+        fp[i] = jump
         for j in range(nb):
             S[i, j] = Rx[i, j] + jump * grad[j]
     return den
 
 
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def saltation_param(guards, reset, mode_old, i_ev, t, xm, p, dpw, gs, xw2, out):
+    """Parameter terms of an event for the sensitivity column psi (direction dpw[0]):
+    psi+ = S psi + jump * g_mu + R_mu. Writes g_mu to gs[0] and R_mu (nb,) to out; p is
+    perturbed in place and restored from dpw[1]."""
+    h = param_step(p, dpw)
+    for k in range(p.size):
+        dpw[1, k] = p[k]
+        p[k] = dpw[1, k] + h * dpw[0, k]
+    guards(mode_old, t, xm, p, gs)
+    gp = gs[i_ev]
+    reset(mode_old, i_ev, t, xm, p, out)
+    for k in range(p.size):
+        p[k] = dpw[1, k] - h * dpw[0, k]
+    guards(mode_old, t, xm, p, gs)
+    gm = gs[i_ev]
+    reset(mode_old, i_ev, t, xm, p, xw2)
+    for k in range(p.size):
+        p[k] = dpw[1, k]
+    for i in range(xm.size):
+        out[i] = (out[i] - xw2[i]) / (2.0 * h)
+    gs[0] = (gp - gm) / (2.0 * h)
+
+
 KERNEL_SIG = types.void(
     VF_TYPE, GUARD_TYPE, RESET_TYPE, JAC_TYPE, MODE_TYPE, types.boolean, types.int64, types.int64,
     types.float64, types.float64, types.float64[::1], types.int64, types.float64[::1],
-    types.int64[:, ::1],
+    types.float64[:, ::1], types.int64[:, ::1],
     types.float64, types.float64, types.float64, types.float64, types.int64, types.int64,
     types.float64, types.boolean,
     types.float64[::1], types.boolean, types.int64, types.int64, types.int64, types.float64,
@@ -290,7 +318,7 @@ def workspace_sizes(n, nb, ng, n_modes, zeno_count):
 
 @numba.njit(KERNEL_SIG, cache=True, error_model="numpy", _nrt=False)
 def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
-                     t0, t1, x0, mode0, p, directions,
+                     t0, t1, x0, mode0, p, dpw, directions,
                      rtol, atol, h0, hmax, max_steps, max_events, guard_tol, fixed,
                      t_eval, record_steps, stop_mode, stop_count, zeno_count, zeno_window,
                      out_t, out_x, out_mode,
@@ -306,9 +334,12 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
     into that mode (counted from ``info[I_STOPHITS]``). ``info[I_IEVAL]`` is the next t_eval
     index, ``info[I_NEVTOT]`` the events so far (both carried across resumes).
 
-    ``nb < x0.size`` integrates sensitivities: x0 = [x (nb), Phi0 row-major (nb * nb)], the
+    ``nb < x0.size`` integrates sensitivities: x0 = [x (nb), Phi0 row-major (nb * m)], the
     variational equations ride along (part of the error control) and every event multiplies Phi
     by its saltation matrix. Guards, transitions and mode_of always see the base state only.
+    With m = nb + 1 the last column is the sensitivity to a parameter mu along the direction
+    dpw[0] = dp/dmu (dpw (2, len(p)), row 1 scratch): psi' = J psi + f_mu, and at events
+    psi+ = S psi + jump g_mu + R_mu; otherwise m = nb and dpw may be NO_PARAM_DIRECTION.
 
     Outputs: info (status, counts, final mode), finfo (final t, last step), x_final, and the
     buffers out_* (points, all n columns) and ev_* (event time, base state before/after, guard,
@@ -409,6 +440,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
         for j in range(n):
             Q[i, j] = 0.0
     sens = nb < n
+    m_sens = (n - nb) // nb          # columns of Phi: nb, or nb + 1 with the parameter column
 
     for i in range(n):
         x[i] = x0[i]
@@ -440,7 +472,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
     expo = -1.0 / 8.0 if method == METHOD_DOP853 else (-1.0 / 5.0 if method == METHOD_DP5 else -0.25)
     status = _S_SUCCESS
 
-    nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, p, f)
+    nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f)
     _guards_base(guards, mode, t, x, p, g_old, xb)
     for i in range(ng):
         armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
@@ -461,7 +493,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
     if h0 > 0.0:
         h = h0
     else:
-        h = select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, p, max(t1 - t, 1e-300), order,
+        h = select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, p, max(t1 - t, 1e-300), order,
                                 rtol, atol, ytmp, ftmp)
         nfev += 1
     n_small = 0
@@ -509,10 +541,10 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                 for i in range(nb):
                     for k in range(nb):
                         J[i, k] = Jb[i, k]
-                        for j in range(nb):
-                            J[nb + i * nb + j, nb + k * nb + j] = Jb[i, k]
+                        for j in range(m_sens):
+                            J[nb + i * m_sens + j, nb + k * m_sens + j] = Jb[i, k]
             njac += 1
-            en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
+            en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
                                       Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
             nfev += fe
             if not conv:
@@ -523,7 +555,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                     break
                 continue
         else:
-            en = explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
+            en = explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
                                y_new, f_new, err)
             nfev += 12 if method == METHOD_DOP853 else 6
         finite = np.isfinite(en)
@@ -560,7 +592,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
         if method == METHOD_RADAU:
             radau_dense(Z, Q)
         elif need_dense:
-            nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, y_new, f_new, h, p, K, ytmp, Q)
+            nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, y_new, f_new, h, p, K, ytmp, Q)
         t_ev = np.inf
         i_ev = -1
         ev_exact = True   # False for threshold events of unarmed guards (no polishing)
@@ -595,7 +627,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
             if ev_exact and t_ev > t:
                 # polish: integrate to the event with one step of the method itself, so the
                 # event state has the method's order rather than its dense output's
-                t_ev, fe = _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, guards, method, mode, i_ev, t, x, f, h,
+                t_ev, fe = _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h,
                                          t_ev, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
                                          y_new, f_new, err, Q, xs, xb, gs)
                 nfev += fe
@@ -609,11 +641,16 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                           gradh, xw, xw2, gs, Rx)
                 nfev += 2
                 for i in range(nb):
-                    for j in range(nb):
+                    for j in range(m_sens):
                         acc = 0.0
                         for k in range(nb):
-                            acc += Ssal[i, k] * xs[nb + k * nb + j]
-                        ytmp[nb + i * nb + j] = acc
+                            acc += Ssal[i, k] * xs[nb + k * m_sens + j]
+                        ytmp[nb + i * m_sens + j] = acc
+                if m_sens > nb:
+                    # the event time moves with mu through g_mu; the reset moves with R_mu
+                    saltation_param(guards, reset, mode, i_ev, t_ev, xb, p, dpw, gs, xw2, fbm)
+                    for i in range(nb):
+                        ytmp[nb + i * m_sens + nb] += fbp[i] * gs[0] + fbm[i]
             elif sens:
                 for i in range(nb, n):
                     ytmp[i] = xs[i]
@@ -666,7 +703,7 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
             if n_ev_total >= max_events:
                 status = _S_MAXEVENTS
                 break
-            nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, x, p, f)
+            nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f)
             _guards_base(guards, mode, t, x, p, g_old, xb)
             for i in range(ng):
                 armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)

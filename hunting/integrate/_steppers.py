@@ -30,7 +30,7 @@ def _rms_scaled(err, y, y_new, rtol, atol):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, p, direction_span, order, rtol, atol,
+def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, p, direction_span, order, rtol, atol,
                         ytmp, ftmp):
     """Hairer's starting step (Solving ODEs I, II.4). Returns h > 0 (one extra f evaluation)."""
     n = y.size
@@ -49,7 +49,7 @@ def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f,
     h0 = min(h0, direction_span)
     for i in range(n):
         ytmp[i] = y[i] + h0 * f[i]
-    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h0, ytmp, p, ftmp)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h0, ytmp, p, ftmp)
     d2 = 0.0
     for i in range(n):
         sc = atol + abs(y[i]) * rtol
@@ -63,7 +63,7 @@ def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f,
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
+def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
                   f_new, err):
     """One explicit Runge-Kutta step (DP5 or DOP853, FSAL). Returns the scaled error norm.
 
@@ -79,7 +79,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, 
                 for j in range(s):
                     acc += DP5_A[s, j] * K[j, i]
                 ytmp[i] = y[i] + h * acc
-            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + DP5_C[s] * h, ytmp, p, err)
+            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + DP5_C[s] * h, ytmp, p, err)
             for i in range(n):
                 K[s, i] = err[i]
         for i in range(n):
@@ -87,7 +87,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, 
             for j in range(ns):
                 acc += DP5_B[j] * K[j, i]
             y_new[i] = y[i] + h * acc
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h, y_new, p, f_new)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new)
         for i in range(n):
             K[ns, i] = f_new[i]
         for i in range(n):
@@ -106,7 +106,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, 
             for j in range(s):
                 acc += D853_A[s, j] * K[j, i]
             ytmp[i] = y[i] + h * acc
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + D853_C[s] * h, ytmp, p, err)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + D853_C[s] * h, ytmp, p, err)
         for i in range(n):
             K[s, i] = err[i]
     for i in range(n):
@@ -114,7 +114,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, 
         for j in range(ns):
             acc += D853_B[j] * K[j, i]
         y_new[i] = y[i] + h * acc
-    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h, y_new, p, f_new)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new)
     for i in range(n):
         K[ns, i] = f_new[i]
     e5 = 0.0
@@ -135,7 +135,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, 
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
+def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
     """Fill the dense-output coefficients Q for the step just accepted (DOP853: 3 more f evals)."""
     n = y.size
     if method == METHOD_DP5:
@@ -152,7 +152,7 @@ def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y,
             for j in range(s):
                 acc += D853_A[s, j] * K[j, i]
             ytmp[i] = y[i] + h * acc
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + D853_C[s] * h, ytmp, p, K[s])
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + D853_C[s] * h, ytmp, p, K[s])
     for i in range(n):
         dy = y_new[i] - y[i]
         Q[0, i] = dy
@@ -208,7 +208,7 @@ def numerical_jacobian(vf, mode, t, y, f, p, rtol, atol, J, ytmp, ftmp):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
+def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
                R, ytmp, y_new, f_new, err):
     """One Radau IIA (order 5) step with simplified Newton on the full 3n stage system.
 
@@ -241,7 +241,7 @@ def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rt
         for a in range(3):
             for i in range(n):
                 ytmp[i] = y[i] + Z[a, i]
-            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + RADAU_C[a] * h, ytmp, p, F3[a])
+            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + RADAU_C[a] * h, ytmp, p, F3[a])
         nfev += 3
         finite = True
         for a in range(3):
@@ -294,7 +294,7 @@ def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rt
         # Hairer's refinement of the estimate for stiff components (one more f evaluation)
         for i in range(n):
             ytmp[i] = y[i] + err[i]
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, ytmp, p, f_new)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, ytmp, p, f_new)
         nfev += 1
         for i in range(n):
             acc = 0.0
@@ -303,7 +303,7 @@ def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t, y, f, h, p, rt
             err[i] = f_new[i] + acc / h
         lu_solve(Mr, pivr, err)
         en = _rms_scaled(err, y, y_new, rtol, atol)
-    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, mode, t + h, y_new, p, f_new)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new)
     nfev += 1
     return en, True, nfev
 

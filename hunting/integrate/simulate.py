@@ -129,7 +129,7 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     for _ in range(10_000):
         steps_left = int(max_steps) - int(info[K.I_NSTEPS] + info[K.I_NREJ])
         K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
-                           system.jacobian is not None, meth, n, t_cur, t1, x_cur, m_cur, p,
+                           system.jacobian is not None, meth, n, t_cur, t1, x_cur, m_cur, p, K.NO_PARAM_DIRECTION,
                            system.directions, rtol, atol, h0, hmax, steps_left, int(max_events),
                            guard_tol, fixed, te, True, sm, int(stop_count), int(zeno_count), zw,
                            out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to,
