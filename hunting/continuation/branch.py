@@ -7,7 +7,8 @@ one) with a quadratic term through the point before. Corrector: quasi-Newton on
 and one flow without sensitivities per iteration; the Jacobian (monodromy-based F_z, F_mu from
 the flow's parameter-sensitivity column) is recomputed only when the residual stops
 contracting, and full Newton takes over where the quasi-Newton fails. Step size grows after
-easy corrections and shrinks after hard or failed ones and sharp turns of the tangent. At every point: Floquet multipliers and stability. Special points: folds (mu
+easy corrections and shrinks after hard or failed ones and sharp turns of the tangent. At
+every point: Floquet multipliers and stability. Special points: folds (mu
 turns back; a multiplier passes +1) located by bisection in arclength, period doublings
 (a multiplier passes -1), tori (a complex pair leaves the unit circle) and "grazing": the
 event sequence of the orbit changes (a stick phase or a velocity reversal appears or vanishes),
@@ -31,13 +32,14 @@ from .shooting import PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude
 class ContinuationOptions:
     """ds : first step (in scaled arclength); ds_min, ds_max : bounds; max_points : bound on
     branch points; newton_tol, newton_max : corrector; dmu : relative step of the central
-    difference in the parameter; fold_tol : relative parameter width at which a fold stops
+    difference d params / d mu; fold_tol : relative parameter width at which a fold stops
     being refined; chord_rate : slowest contraction of the residual accepted with a kept
-    Jacobian (slower ones recompute it); max_correction : largest corrector move as a fraction of ds and max_angle
-    [rad] the largest turn of the tangent in one step (larger ones halve ds: no branch jumping);
-    jacobian_rtol : rtol of the flows with
-    sensitivities (monodromy matrix, d phi / d mu); the orbits themselves are as accurate as
-    the shooting options' rtol."""
+    Jacobian (slower ones recompute it); max_correction : largest corrector move as a fraction
+    of ds and max_angle [rad] the largest turn of the tangent in one step (larger ones halve
+    ds: no branch jumping); jacobian_rtol : rtol of the flows with sensitivities recomputed
+    inside the corrector (they only steer it). Residual flows run at min(shooting rtol,
+    newton_tol / 100), each converged point's Jacobian (multipliers, tangent) at 100 times
+    that."""
 
     ds: float = 0.05
     ds_min: float = 1e-6
@@ -144,7 +146,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     def param_direction(mu):
         """d params / d mu at mu (central differences of system_at: exact for the usual
         parameters, which enter the array linearly)."""
-        h = 1e-6 * max(abs(mu), 1e-3)
+        h = opt.dmu * max(abs(mu), 1e-3)
         return (system_at(mu + h).params - system_at(mu - h).params) / (2 * h)
 
     def residual_and_jac(v, need_jac=True, precise=False):
@@ -244,7 +246,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     t = tangent(J)
     if np.sign(t[-1]) != np.sign(mu_end - mu0):
         t = -t
-    pts_v, pts_fl, tangents = [v], [fl], [t]
+    pts_v, pts_fl = [v], [fl]
     J_prev = None
     special: list[SpecialPoint] = []
     ds = opt.ds
@@ -303,7 +305,6 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         v, t, fl, J, J_prev = v_new, t_new, fl_new, J_new, J
         pts_v.append(v)
         pts_fl.append(fl)
-        tangents.append(t)
         if mu_new < lo or mu_new > hi:
             break
         if turns >= max_turns and stop_at_mu is not None:

@@ -48,7 +48,6 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
         raise SystemDefinitionError(f"T = {T!r} is not allowed: the period must be a finite number > 0")
     n = system.n_states
     p = system.params if params is None else np.ascontiguousarray(params, dtype=np.float64)
-    p = p.copy()                                  # the kernel perturbs p in place for f_mu
     dpw = K.NO_PARAM_DIRECTION
     m = n
     if param_direction is not None:
@@ -59,6 +58,7 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
         if not sensitivity:
             raise SystemDefinitionError("param_direction needs sensitivity=True")
         dpw = np.vstack([dp, np.zeros_like(dp)])
+        p = p.copy()                              # the kernel perturbs p in place for f_mu
         m = n + 1
     y0 = np.concatenate([x0, np.eye(n, m).ravel()]) if sensitivity else x0.copy()
     N = y0.size
