@@ -60,6 +60,61 @@ def test_two_hidden_effects_are_both_found():
     assert names["cogging"].parameters["pitch"] == pytest.approx(0.02, rel=0.02)
 
 
+def _two_mass_measurement(seed, m1=75.0, m2=20.0, f0=18.0, zeta=0.05, cm=35.15, Fc=20.0, b=200.0,
+                          duration=24.0, dt=1e-3):
+    """A motor (m1, measured) driving a load m2 through a spring-damper (f0, zeta): the motor
+    follows a smooth multisine; the load is integrated by solve_ivp (not by the cause's
+    bilinear filter), and u = (m1 a1 + m2 a2 + F(v1)) / cm with noise; positions quantized."""
+    from scipy.integrate import solve_ivp
+
+    from hunting.diagnose import Measurement
+    rng = np.random.default_rng(seed)
+    freqs = np.array([0.2, 0.45, 1.1, 3.3, 7.7, 12.1, 16.9, 23.7, 31.3])
+    amps = 0.04 / (1 + freqs ** 2) * rng.uniform(0.7, 1.3, freqs.size)
+    ph = rng.uniform(0, 2 * np.pi, freqs.size)
+    w = 2 * np.pi * freqs
+
+    def motor(t):
+        return ((amps * np.sin(np.multiply.outer(t, w) + ph)).sum(-1),
+                (amps * w * np.cos(np.multiply.outer(t, w) + ph)).sum(-1),
+                -(amps * w ** 2 * np.sin(np.multiply.outer(t, w) + ph)).sum(-1))
+    k, c = m2 * (2 * np.pi * f0) ** 2, 2 * zeta * m2 * 2 * np.pi * f0
+
+    def load(t, y):
+        q1, v1, _ = motor(np.array([t]))
+        return [y[1], (k * (q1[0] - y[0]) + c * (v1[0] - y[1])) / m2]
+    t = np.arange(0.0, duration, dt)
+    # a digital drive holds u_k over [t_k, t_k + dt): the force it stands for acts at t_k + dt / 2
+    th = t + 0.5 * dt
+    q1, v1, a1 = motor(th)
+    sol = solve_ivp(load, (0, th[-1]), [q1[0], v1[0]], t_eval=th, rtol=1e-10, atol=1e-13, max_step=dt)
+    a2 = (k * (q1 - sol.y[0]) + c * (v1 - sol.y[1])) / m2
+    F = m1 * a1 + m2 * a2 + Fc * np.sign(v1) + b * v1
+    u = F / cm + rng.normal(0, 0.01, t.size)
+    q = np.round((motor(t)[0] + rng.normal(0, 2e-7, t.size)) / 1e-6) * 1e-6
+    return Measurement(t, q, u)
+
+
+def test_hidden_flexibility_is_found():
+    """A load on a spring behind the motor (75 + 20 kg, 18 Hz, zeta 0.05): the rigid model with the
+    total mass sees it as a resonance in the residual; flexibility must be ranked first with its
+    frequency and load mass recovered."""
+    model = NominalModel.from_dict({"plant": {"mass": 95.0, "motor_constant": 35.15},
+                                    "friction": {"law": "coulomb-viscous", "Fc": 20.0, "b": 200.0}})
+    dg = diagnose(_two_mass_measurement(1), model, _two_mass_measurement(2), behaviour=False)
+    c = dg.causes[0]
+    assert c.name == "flexibility"
+    assert c.parameters["frequency"] == pytest.approx(18.0, rel=0.05)
+    # the load mass comes out low (14.1 of 20 kg): the force is smoothed by the SG filter while
+    # the acceleration's SG derivative attenuates more at 18 Hz (0.80 against 0.97), a mismatch
+    # the mass and delay causes share with this one (known, see the issue notes)
+    assert 0.6 * 20.0 < c.parameters["load_mass"] < 1.1 * 20.0
+    assert dg.extended < 0.5 * dg.nominal
+    ext = dg.extended_model
+    assert ext.flexibility is not None and ext.flexibility.frequency == c.parameters["frequency"]
+    assert NominalModel.from_dict(ext.to_dict()).flexibility == ext.flexibility     # schema round trip
+
+
 def test_emps_offset_and_asymmetry(shared_dir, tmp_path):
     d = shared_dir / "data" / "emps"
     if not (d / "DATA_EMPS.mat").is_file():

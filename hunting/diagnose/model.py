@@ -7,7 +7,8 @@ Schema (keys beyond these are errors, so typos are caught):
     {"preset": "table9.1", "set": {"P": 60.0}}
     {"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 0.0, "delay": 0.0,
                "cogging": [{"pitch": 0.02, "cos": [..], "sin": [..]}, ...],      # harmonics k = 1, 2..
-               "cogging_table": [{"q": [..], "F": [..]}, ...]},                 # linear interpolation
+               "cogging_table": [{"q": [..], "F": [..]}, ...],                  # linear interpolation
+               "flexibility": {"load_mass": 20.0, "frequency": 25.0, "damping": 0.05}},  # [kg, Hz, -]
      "friction": {"law": "coulomb-viscous" | "stribeck" | "switch" | "lugre",
                   "Fc": .., "Fs": .., "vs": .., "beta": .., "b": .., "sigma0": .., "sigma1": ..,
                   "sigma2": (alias of b), "Fc_neg": .., ... (direction-dependent values)},
@@ -29,8 +30,41 @@ from ..models.plant import COG_TABLE, Cogging
 LAWS = ("coulomb-viscous", "stribeck", "switch", "lugre")
 _FRICTION_KEYS = {"law", "Fc", "Fs", "vs", "beta", "b", "sigma0", "sigma1", "sigma2",
                   "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg"}
-_PLANT_KEYS = {"mass", "motor_constant", "offset", "delay", "cogging", "cogging_table"}
+_PLANT_KEYS = {"mass", "motor_constant", "offset", "delay", "cogging", "cogging_table", "flexibility"}
 _CONTROLLER_TYPES = ("pid", "pd-velocity-loop")
+
+
+@dataclass(frozen=True)
+class Flexibility:
+    """A load of mass load_mass [kg] on a spring-damper behind the measured (motor) side: natural
+    frequency [Hz] and damping ratio of the load on its coupling. The rigid model's mass is the
+    total; the flexible load adds the force m2 (a2 - a1) = -m2 H(s) a1 to the motor side, with
+    H(s) = s^2 / (s^2 + 2 zeta w s + w^2) acting on the measured acceleration a1."""
+
+    load_mass: float
+    frequency: float
+    damping: float
+
+    def __post_init__(self):
+        check_finite_positive("flexibility load_mass", self.load_mass, allow_zero=True)
+        check_finite_positive("flexibility frequency", self.frequency)
+        check_finite_positive("flexibility damping", self.damping)
+
+    def force(self, a: np.ndarray, dt: float) -> np.ndarray:
+        """The load's force on the motor side [N] for motor accelerations a (n,) sampled at dt."""
+        return -self.load_mass * highpass_response(a, dt, self.frequency, self.damping)
+
+
+def highpass_response(a: np.ndarray, dt: float, frequency: float, damping: float) -> np.ndarray:
+    """H(s) a with H(s) = s^2 / (s^2 + 2 zeta w s + w^2), w = 2 pi frequency: causal, discretized
+    by the bilinear transform prewarped at w (exact gain and phase at the resonance)."""
+    from scipy.signal import bilinear, lfilter
+    w = 2 * np.pi * frequency
+    fs = 1.0 / dt
+    # prewarping: design at the analog frequency that the bilinear map sends to w
+    wa = 2 * fs * np.tan(w / (2 * fs))
+    b, den = bilinear([1.0, 0.0, 0.0], [1.0, 2 * damping * wa, wa ** 2], fs)
+    return lfilter(b, den, np.asarray(a, dtype=float))
 
 
 @dataclass(frozen=True)
@@ -40,7 +74,8 @@ class NominalModel:
     equation m q'' = cm u + f_ext - F(q') - offset); sigma0, sigma1 : LuGre parameters when the
     law is lugre; controller : the controller description (dict), or None; source : the dict.
     cogging : tuple of :class:`hunting.models.plant.Cogging` components (harmonic or table),
-    summed; delay [s] : actuation delay (the plant
+    summed; flexibility : a :class:`Flexibility` (load on a spring behind the measured side; the
+    force residual has it, the re-simulation does not); delay [s] : actuation delay (the plant
     receives cm u(t - delay)); resolution [m] and sensor_noise [m] : the position sensor's
     quantization step and noise standard deviation before quantization (used by re-simulation;
     resolution None: read from the data). All forces act like friction: m q'' = cm u - F(q') - offset - F_cog(q)."""
@@ -58,6 +93,7 @@ class NominalModel:
     delay: float = 0.0
     resolution: float | None = None
     sensor_noise: float = 0.0
+    flexibility: Flexibility | None = None
 
     def __post_init__(self):
         check_finite_positive("mass", self.mass)
@@ -122,6 +158,9 @@ class NominalModel:
             plant["cogging"] = [{"pitch": c.period, "cos": list(c.data[0::2]), "sin": list(c.data[1::2])} for c in harm]
         if tabs:
             plant["cogging_table"] = [{"q": list(c.data[:c.n]), "F": list(c.data[c.n:])} for c in tabs]
+        if self.flexibility is not None:
+            f = self.flexibility
+            plant["flexibility"] = {"load_mass": f.load_mass, "frequency": f.frequency, "damping": f.damping}
         d = {"plant": plant, "friction": fr}
         if self.controller is not None:
             d["controller"] = self.controller
@@ -199,7 +238,17 @@ class NominalModel:
         return NominalModel(float(pl["mass"]), float(pl.get("motor_constant", 1.0)), DirectionalCurve(pos, neg), law,
                             offset=float(pl.get("offset", 0.0)), sigma0=fr.get("sigma0"), sigma1=fr.get("sigma1"),
                             controller=ctrl, source=d, cogging=_cogging(pl.get("cogging", []), pl.get("cogging_table", [])), delay=float(pl.get("delay", 0.0)),
-                            **sens)
+                            flexibility=_flexibility(pl.get("flexibility")), **sens)
+
+
+def _flexibility(d) -> Flexibility | None:
+    if d is None:
+        return None
+    keys = {"load_mass", "frequency", "damping"}
+    if not isinstance(d, dict) or set(d) != keys:
+        raise SystemDefinitionError(f"plant flexibility = {d!r} must be {{'load_mass': kg, 'frequency': Hz, "
+                                    "'damping': ratio}")
+    return Flexibility(float(d["load_mass"]), float(d["frequency"]), float(d["damping"]))
 
 
 def _cogging(harmonics, tables) -> tuple:

@@ -17,8 +17,8 @@ def with_curves(model: NominalModel, pos, neg=None) -> NominalModel:
     return model.replace(curve=DirectionalCurve(pos(model.curve.positive), neg(model.curve.negative)))
 
 
-from . import asymmetry, cogging, delay, mass, offset, presliding, stribeck, viscous  # noqa: E402
+from . import asymmetry, cogging, delay, flexibility, mass, offset, presliding, stribeck, viscous  # noqa: E402
 
-CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, stribeck, viscous, mass, delay, presliding)}
+CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, stribeck, viscous, mass, delay, flexibility, presliding)}
 
 __all__ = ["CAUSES"]
