@@ -3,7 +3,12 @@
 Positions are differentiated with a Savitzky-Golay filter (local cubic least squares over
 ``window`` seconds, zero phase); the drive force cm u + f_ext goes through the same smoothing
 (parallel filtering, as in inverse-dynamics identification) so both sides of the force balance
-have the same bandwidth; u is aligned for the zero-order hold of a digital controller. The residual of a model is r = force - m a - F(v) - offset - F_cog(q)
+have the same bandwidth: :meth:`Kinematics.filtered` is that filter, and the model's static maps
+(friction F(v), cogging F(q)) and the causes' regressors that are functions of v or q go through it
+too (unfiltered, the friction's jump at a velocity reversal stays sharp while the measured force's
+is smoothed over the window, and the residual shows a false low-speed friction dip); u is aligned
+for the zero-order hold of a digital controller. The residual of a model is
+r = force - m a - H_a[F(v) + F_cog(q)] - offset
 (and the first-order delay term)."""
 from __future__ import annotations
 
@@ -33,6 +38,23 @@ class Kinematics:
     window: float
     moving: np.ndarray
 
+    def filtered(self, x: np.ndarray) -> np.ndarray:
+        """x (n,) or (n, k) through the acceleration's filter (the one the force went through)."""
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 2:
+            return np.column_stack([self.filtered(c) for c in x.T]) if x.shape[1] else x
+        dt = float(self.t[1] - self.t[0])
+        return _acceleration_filter(x, dt, int(round(self.window / dt)))
+
+
+def _acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
+    """The low pass H_a of the SG second derivative (w samples, cubic) applied to x (n,): the
+    derivative filter on x's double (trapezoidal) integral (it annihilates the integration
+    constants, so the result is exactly H_a x)."""
+    m = float(np.mean(x))
+    x2 = cumulative_trapezoid(cumulative_trapezoid(x - m, dx=dt, initial=0.0), dx=dt, initial=0.0)
+    return savgol_filter(x2, w, 3, deriv=2, delta=dt, mode="interp") + m
+
 
 def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_min_frac: float = 0.02) -> Kinematics:
     """Smoothed derivatives of a measurement (see the module docstring). window [s] defaults to
@@ -51,11 +73,8 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     # the force goes through the acceleration's own filter: the SG second derivative is
     # d^2/dt^2 times a low-pass H_a(w) that attenuates more than SG smoothing does (0.80 against
     # 0.97 at 18 Hz for 31 samples at 1 kHz), so smoothing the force would leave m (1 - H_a) a in
-    # the residual. Applying the derivative filter to the force's double (trapezoidal) integral
-    # gives exactly H_a (the filter annihilates the integration constants).
-    F = cm * u_at + meas.force_ext()
-    F2 = cumulative_trapezoid(cumulative_trapezoid(F - F.mean(), dx=dt, initial=0.0), dx=dt, initial=0.0)
-    force = savgol_filter(F2, deriv=2, delta=dt, **sg) + F.mean()
+    # the residual
+    force = _acceleration_filter(cm * u_at + meas.force_ext(), dt, w)
     du = savgol_filter(meas.u, deriv=1, delta=dt, **sg)
     moving = np.abs(v) > v_min_frac * np.max(np.abs(v))
     edge = np.zeros(meas.n, bool)
@@ -64,10 +83,10 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
 
 
 def residual(kin: Kinematics, model) -> np.ndarray:
-    """Force residual r = force - delay cm u' - m a - F(v) - offset - F_cog(q) - F_flex [N] of a
-    NominalModel (the delay to first order: cm u(t - delay) ~ cm u(t) - delay cm u'(t))."""
-    r = (kin.force - model.delay * kin.cm * kin.du - model.mass * kin.a - model.friction(kin.v) - model.offset
-         - model.cogging_force(kin.q))
+    """Force residual r = force - delay cm u' - m a - offset - H_a[F(v) + F_cog(q)] - F_flex [N] of
+    a NominalModel (H_a : :meth:`Kinematics.filtered`) (the delay to first order: cm u(t - delay) ~ cm u(t) - delay cm u'(t))."""
+    r = (kin.force - model.delay * kin.cm * kin.du - model.mass * kin.a - model.offset
+         - kin.filtered(model.friction(kin.v) + model.cogging_force(kin.q)))
     if model.flexibility is not None:
         r = r - model.flexibility.force(kin.a, float(kin.t[1] - kin.t[0]))
     return r

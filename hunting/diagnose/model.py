@@ -268,10 +268,10 @@ def _cogging(harmonics, tables) -> tuple:
 
 def fit_coulomb_viscous(kin, *, v_min_frac: float = 0.02) -> tuple[NominalModel, dict]:
     """Symmetric Coulomb + viscous model without offset by least squares on the inverse dynamics
-    (IDIM-LS): force = m a + Fc sign(v) + b v on the samples with |v| > v_min_frac max|v|.
+    (IDIM-LS): force = m a + H_a[Fc sign(v) + b v] on the samples with |v| > v_min_frac max|v|.
     kin : Kinematics. Returns (model, {"mass", "Fc", "b"} standard uncertainties)."""
     sel = np.abs(kin.v) > v_min_frac * np.max(np.abs(kin.v))
-    Phi = np.column_stack([kin.a, np.sign(kin.v), kin.v])[sel]
+    Phi = np.column_stack([kin.a, kin.filtered(np.column_stack([np.sign(kin.v), kin.v]))])[sel]
     theta, *_ = np.linalg.lstsq(Phi, kin.force[sel], rcond=None)
     r = kin.force[sel] - Phi @ theta
     s2 = float(r @ r) / max(sel.sum() - 3, 1)

@@ -4,7 +4,8 @@ hyper-parameter variants to try, chosen from the fitting data: e.g. cogging pitc
 ``design(kin, model, hyper)`` (regressors (n, k) of the force residual, linear in the
 extension's parameters) and ``parameters(theta, hyper, model)`` turning the fitted coefficients
 into named physical parameters, and ``extend(model, theta, hyper)`` returning the extended
-NominalModel (what the behaviour view re-simulates). Adding a cause is adding a module and
+NominalModel (what the behaviour view re-simulates); optionally ``unphysical(theta, hyper, model)``
+returning why a fitted theta is not the physical effect (the cause is then rejected), else None. Adding a cause is adding a module and
 listing it here."""
 from ..model import NominalModel
 from ...models.friction import DirectionalCurve

@@ -15,7 +15,7 @@ def hypers(kin, model) -> list:
 
 
 def design(kin, model, hyper):
-    return np.abs(kin.v)[:, None]
+    return kin.filtered(np.abs(kin.v))[:, None]
 
 
 def parameters(theta, hyper, model) -> dict:

@@ -39,7 +39,7 @@ def design(kin, model, hyper):
     for k in range(1, HARMONICS + 1):
         w = 2 * np.pi * k / hyper["pitch"]
         cols += [np.cos(w * kin.q), np.sin(w * kin.q)]
-    return np.column_stack(cols)
+    return kin.filtered(np.column_stack(cols))
 
 
 def parameters(theta, hyper, model) -> dict:

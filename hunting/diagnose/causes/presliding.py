@@ -3,7 +3,8 @@ break-away level, where a Switch-type model holds it still (chapters 4.4, 10.4.2
 
 A stick-channel cause: it is judged on the samples where the nominal model says the mass sticks
 (|v| below ``v_stick`` and the force friction must carry, F = cm u + f_ext - offset - F_cog - m a,
-inside the stick set (-Fs-, Fs+)), over segments of at least ``min_time``. The nominal model
+inside the stick set (-Fs-, Fs+)), over segments of at least ``min_time`` after half a smoothing
+window is trimmed from each end. The nominal model
 predicts no motion there; LuGre predicts quasi-static bristle deflection z = F / sigma0 with
 z' = v - sigma0 |v| z / g, i.e. along a segment
 
@@ -34,7 +35,7 @@ ZETA = 0.5
 def friction_force(kin, model) -> np.ndarray:
     """The force friction must carry [N] (n,), from the measured drive and motion."""
     from ..kinematics import residual
-    return residual(kin, model) + model.friction(kin.v)
+    return residual(kin, model) + kin.filtered(model.friction(kin.v))
 
 
 def v_stick(kin, model) -> float:
@@ -55,7 +56,10 @@ def segments(kin, model, *, min_time: float = 0.05) -> list[tuple[int, int]]:
     ok[-w:] = False
     edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(np.int8), [0]])))
     need = max(int(min_time / dt), 20)
-    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2]) if b - a >= need]
+    # the smoothed v and F at a run's ends still see the slip within half a filter window (the
+    # last counts of a deceleration, the first of a break-away): trim that much from both ends
+    h = w // 2 + 1
+    return [(int(a) + h, int(b) - 1 - h) for a, b in zip(edges[::2], edges[1::2]) if b - a - 2 * h >= need]
 
 
 def _smooth(x: np.ndarray, L: int) -> np.ndarray:

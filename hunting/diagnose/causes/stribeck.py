@@ -20,7 +20,14 @@ def hypers(kin, model) -> list:
 
 def design(kin, model, hyper):
     s = np.sign(kin.v)
-    return np.column_stack([s, s * np.exp(-(np.abs(kin.v) / hyper["vs"]) ** 2)])
+    return kin.filtered(np.column_stack([s, s * np.exp(-(np.abs(kin.v) / hyper["vs"]) ** 2)]))
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    if theta[1] < 0:
+        return (f"Fs - Fc = {theta[1]:.3g} N < 0 (friction rising with speed at low speed); a force dip at low "
+                "speed through reversals is frictional memory (lag) or presliding, not a Stribeck curve")
+    return None
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -33,6 +40,6 @@ def extend(model, theta, hyper):
     own Stribeck term when it had one)."""
     def new(c):
         Fc = max(c.Fc + float(theta[0]), 0.0)
-        return replace(c, Fc=Fc, Fs=max(Fc + float(theta[1]), Fc), vs=hyper["vs"], beta=2.0)
+        return replace(c, Fc=Fc, Fs=Fc + float(theta[1]), vs=hyper["vs"], beta=2.0)
     out = with_curves(model, new)
     return out.replace(law="stribeck") if model.law == "coulomb-viscous" else out

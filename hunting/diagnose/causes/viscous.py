@@ -12,7 +12,7 @@ def hypers(kin, model) -> list:
 
 
 def design(kin, model, hyper):
-    return kin.v[:, None]
+    return kin.filtered(kin.v)[:, None]
 
 
 def parameters(theta, hyper, model) -> dict:
