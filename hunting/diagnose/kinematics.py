@@ -86,7 +86,7 @@ def residual(kin: Kinematics, model) -> np.ndarray:
     """Force residual r = force - delay cm u' - m a - offset - H_a[F(v) + F_cog(q)] - F_flex [N] of
     a NominalModel (H_a : :meth:`Kinematics.filtered`) (the delay to first order: cm u(t - delay) ~ cm u(t) - delay cm u'(t))."""
     r = (kin.force - model.delay * kin.cm * kin.du - model.mass * kin.a - model.offset
-         - kin.filtered(model.friction(kin.v) + model.cogging_force(kin.q)))
+         - kin.filtered(model.friction(kin.v) + model.lag_force(kin.v, kin.a) + model.cogging_force(kin.q)))
     if model.flexibility is not None:
         r = r - model.flexibility.force(kin.a, float(kin.t[1] - kin.t[0]))
     return r

@@ -11,7 +11,9 @@ Schema (keys beyond these are errors, so typos are caught):
                "flexibility": {"load_mass": 20.0, "frequency": 25.0, "damping": 0.05}},  # [kg, Hz, -]
      "friction": {"law": "coulomb-viscous" | "stribeck" | "switch" | "lugre",
                   "Fc": .., "Fs": .., "vs": .., "beta": .., "b": .., "sigma0": .., "sigma1": ..,
-                  "sigma2": (alias of b), "Fc_neg": .., ... (direction-dependent values)},
+                  "sigma2": (alias of b), "Fc_neg": .., ... (direction-dependent values),
+                  "lag": 0.01,                                   # [s] frictional memory
+                  "dwell": {"level": 0.0, "gain": 5.0, "time": 1.0}},   # [N, N, s] break-away growth
      "controller": {"type": "pid", "form": "PDI" | "K", ...} | {"type": "pd-velocity-loop", ...},
      "sensor": {"resolution": 1e-6, "noise": 2e-7}}          # [m]; optional (see resimulate.py)
 """
@@ -29,7 +31,7 @@ from ..models.plant import COG_TABLE, Cogging
 
 LAWS = ("coulomb-viscous", "stribeck", "switch", "lugre")
 _FRICTION_KEYS = {"law", "Fc", "Fs", "vs", "beta", "b", "sigma0", "sigma1", "sigma2",
-                  "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg"}
+                  "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg", "lag", "dwell"}
 _PLANT_KEYS = {"mass", "motor_constant", "offset", "delay", "cogging", "cogging_table", "flexibility"}
 _CONTROLLER_TYPES = ("pid", "pd-velocity-loop")
 
@@ -55,6 +57,26 @@ class Flexibility:
         return -self.load_mass * highpass_response(a, dt, self.frequency, self.damping)
 
 
+@dataclass(frozen=True)
+class Dwell:
+    """Break-away force growing with the time at rest t_r (static laws): Fs + level + gain (1 -
+    exp(-t_r / time)) in either direction [N, N, s] (Kato's dwell-time effect); sliding friction is
+    unchanged."""
+
+    level: float
+    gain: float
+    time: float
+
+    def __post_init__(self):
+        check_finite("dwell level", self.level)
+        check_finite_positive("dwell gain", self.gain, allow_zero=True)
+        check_finite_positive("dwell time", self.time)
+
+    def breakaway(self, Fs, t_rest) -> np.ndarray:
+        """Break-away force [N] after rests t_rest [s] for static level Fs [N]."""
+        return Fs + self.level + self.gain * (1.0 - np.exp(-np.asarray(t_rest, float) / self.time))
+
+
 def highpass_response(a: np.ndarray, dt: float, frequency: float, damping: float) -> np.ndarray:
     """H(s) a with H(s) = s^2 / (s^2 + 2 zeta w s + w^2), w = 2 pi frequency: causal, discretized
     by the bilinear transform prewarped at w (exact gain and phase at the resonance)."""
@@ -75,7 +97,10 @@ class NominalModel:
     law is lugre; controller : the controller description (dict), or None; source : the dict.
     cogging : tuple of :class:`hunting.models.plant.Cogging` components (harmonic or table),
     summed; flexibility : a :class:`Flexibility` (load on a spring behind the measured side; the
-    force residual has it, the re-simulation does not); delay [s] : actuation delay (the plant
+    force residual has it, the re-simulation does not); lag [s] : frictional memory of static
+    laws (the Stribeck level follows g(|v|) through a first-order lag; residual to first order and
+    re-simulation); dwell : a :class:`Dwell` (break-away force growing with the time at rest;
+    re-simulation); delay [s] : actuation delay (the plant
     receives cm u(t - delay)); resolution [m] and sensor_noise [m] : the position sensor's
     quantization step and noise standard deviation before quantization (used by re-simulation;
     resolution None: read from the data). All forces act like friction: m q'' = cm u - F(q') - offset - F_cog(q)."""
@@ -94,8 +119,15 @@ class NominalModel:
     resolution: float | None = None
     sensor_noise: float = 0.0
     flexibility: Flexibility | None = None
+    lag: float = 0.0
+    dwell: Dwell | None = None
 
     def __post_init__(self):
+        check_finite_positive("friction lag", self.lag, allow_zero=True)
+        if self.lag and self.law == "lugre":
+            raise SystemDefinitionError("friction lag applies to the static laws; LuGre has its own memory (sigma0, sigma1)")
+        if self.dwell is not None and not isinstance(self.dwell, Dwell):
+            raise SystemDefinitionError(f"dwell = {self.dwell!r} must be a Dwell")
         check_finite_positive("mass", self.mass)
         check_finite_positive("motor_constant", self.cm)
         check_finite("offset", self.offset)
@@ -121,6 +153,15 @@ class NominalModel:
         out[p] = pos.level(v[p]) + pos.b * v[p]
         out[n] = -neg.level(-v[n]) + neg.b * v[n]
         return out
+
+    def lag_force(self, v, a) -> np.ndarray:
+        """The frictional memory's change of the friction force [N] to first order: the lagging
+        level g - lag dg/dt, i.e. -lag g'(|v|) a (v, a : (n,) [m/s, m/s^2]); 0 without lag."""
+        v = np.asarray(v, dtype=float)
+        if not self.lag:
+            return np.zeros_like(v)
+        slope = np.where(v >= 0, self.curve.positive.level_slope(v), self.curve.negative.level_slope(v))
+        return -self.lag * slope * np.asarray(a, dtype=float)
 
     def v_stick(self) -> float:
         """Speed [m/s] below which this model's mass counts as stuck when judging data: a tenth
@@ -149,6 +190,10 @@ class NominalModel:
                       beta_neg=c.negative.beta, b_neg=c.negative.b)
         if self.law == "lugre":
             fr.update(sigma0=self.sigma0, sigma1=self.sigma1)
+        if self.lag:
+            fr["lag"] = self.lag
+        if self.dwell is not None:
+            fr["dwell"] = {"level": self.dwell.level, "gain": self.dwell.gain, "time": self.dwell.time}
         plant = {"mass": self.mass, "motor_constant": self.cm, "offset": self.offset}
         if self.delay:
             plant["delay"] = self.delay
@@ -238,7 +283,16 @@ class NominalModel:
         return NominalModel(float(pl["mass"]), float(pl.get("motor_constant", 1.0)), DirectionalCurve(pos, neg), law,
                             offset=float(pl.get("offset", 0.0)), sigma0=fr.get("sigma0"), sigma1=fr.get("sigma1"),
                             controller=ctrl, source=d, cogging=_cogging(pl.get("cogging", []), pl.get("cogging_table", [])), delay=float(pl.get("delay", 0.0)),
-                            flexibility=_flexibility(pl.get("flexibility")), **sens)
+                            flexibility=_flexibility(pl.get("flexibility")), lag=float(fr.get("lag", 0.0)),
+                            dwell=_dwell(fr.get("dwell")), **sens)
+
+
+def _dwell(d) -> Dwell | None:
+    if d is None:
+        return None
+    if not isinstance(d, dict) or set(d) != {"level", "gain", "time"}:
+        raise SystemDefinitionError(f"friction dwell = {d!r} must be {{'level': N, 'gain': N, 'time': s}}")
+    return Dwell(float(d["level"]), float(d["gain"]), float(d["time"]))
 
 
 def _flexibility(d) -> Flexibility | None:

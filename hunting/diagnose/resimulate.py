@@ -19,7 +19,8 @@ Controllers (the MODEL.json ``controller`` schema):
   {"type": "pid", "kp", "kd", "ki"}                     plain gains
   common pid keys: "derivative_on": "error" | "measurement", "tau_f" [s] (first-order filter of
   the difference quotient), "sample_time" [s], "saturation" (|u| bound, default none);
-  {"type": "pd-velocity-loop", "kp" [1/s], "kv", "sample_time", "saturation"}:
+  "output_resolution" (the DAC's step of u, default none);
+  {"type": "pd-velocity-loop", "kp" [1/s], "kv", "sample_time", "saturation", "output_resolution"}:
   u = kv (kp (q_ref - q) - v_f), v_f the backward difference of the 2-tap averaged position
   (the EMPS benchmark's controller).
 The integral state starts where the first controller output equals the measured u[0]."""
@@ -40,8 +41,8 @@ from .model import NominalModel
 
 _PID, _PDV = 1.0, 2.0
 _CTRL_KEYS = {"pid": {"type", "form", "P", "D", "I", "K", "tau_d", "tau_i", "kp", "kd", "ki", "derivative_on",
-                      "tau_f", "sample_time", "saturation"},
-              "pd-velocity-loop": {"type", "kp", "kv", "sample_time", "saturation"}}
+                      "tau_f", "sample_time", "saturation", "output_resolution"},
+              "pd-velocity-loop": {"type", "kp", "kv", "sample_time", "saturation", "output_resolution"}}
 
 
 @dataclass(frozen=True)
@@ -49,7 +50,7 @@ class SampledController:
     """A digital controller from the schema: kind "pid" or "pd-velocity-loop"; kp, kd, ki [u/m,
     u s/m, u/(m s)] for pid (kp [1/s] and kv [u s/m] for the velocity loop); tau_f [s];
     derivative_on_measurement; sample_time [s] or None (the data's); saturation (|u| bound, inf
-    for none)."""
+    for none); output_resolution (the DAC's step of u, 0 for none)."""
 
     kind: str
     kp: float
@@ -60,6 +61,7 @@ class SampledController:
     derivative_on_measurement: bool = False
     sample_time: float | None = None
     saturation: float = math.inf
+    output_resolution: float = 0.0
 
     @staticmethod
     def from_schema(d: dict) -> "SampledController":
@@ -73,12 +75,13 @@ class SampledController:
         ts = d.get("sample_time")
         ts = None if ts is None else check_finite_positive("controller sample_time", ts)
         sat = check_finite_positive("controller saturation", d.get("saturation", math.inf), allow_inf=True)
+        dac = check_finite_positive("controller output_resolution", d.get("output_resolution", 0.0), allow_zero=True)
         if kind == "pd-velocity-loop":
             for k in ("kp", "kv"):
                 if k not in d:
                     raise SystemDefinitionError(f"controller (pd-velocity-loop): {k!r} is required")
             return SampledController(kind, check_finite("kp", d["kp"]), kv=check_finite("kv", d["kv"]),
-                                     sample_time=ts, saturation=sat)
+                                     sample_time=ts, saturation=sat, output_resolution=dac)
         form = d.get("form", "gains")
         if form == "PDI":
             pid = PID.pdi(d.get("P", 0.0), d.get("D", 0.0), d.get("I", 0.0))
@@ -93,10 +96,11 @@ class SampledController:
         if on not in ("error", "measurement"):
             raise SystemDefinitionError(f"controller derivative_on = {on!r}: use 'error' or 'measurement'")
         tau_f = check_finite_positive("controller tau_f", d.get("tau_f", 0.0), allow_zero=True)
-        return SampledController("pid", pid.kp, pid.kd, pid.ki, 0.0, tau_f, on == "measurement", ts, sat)
+        return SampledController("pid", pid.kp, pid.kd, pid.ki, 0.0, tau_f, on == "measurement", ts, sat, dac)
 
     def array(self, dt: float) -> np.ndarray:
-        """[kind code, kp, kd, ki, kv, tau_f, d_on_meas, saturation, hold] for the kernel; hold =
+        """[kind code, kp, kd, ki, kv, tau_f, d_on_meas, saturation, hold, output_resolution] for the
+        kernel; hold =
         data samples per controller update (sample_time / dt, an integer)."""
         hold = 1
         if self.sample_time is not None:
@@ -107,7 +111,7 @@ class SampledController:
                     f"sample interval {dt!r} s: resample the data or correct sample_time")
         code = _PID if self.kind == "pid" else _PDV
         return np.array([code, self.kp, self.kd, self.ki, self.kv, self.tau_f, float(self.derivative_on_measurement),
-                         self.saturation, float(hold)])
+                         self.saturation, float(hold), self.output_resolution])
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -120,14 +124,18 @@ def _cog(q, cog, bases):
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
 def _rates(q, v, z, s, fa, p, cog, bases):
-    """(q', v', z') at applied force fa (cm u + f_ext - offset), direction s for the curve."""
+    """(q', v', z') at applied force fa (cm u + f_ext - offset), direction s for the curve. z is
+    LuGre's bristle deflection, or for a static law with frictional memory (lag p[16] > 0) the
+    lagging Stribeck level: z' = (g(|v|) - z) / lag, F = s z + b v."""
     base = 4 if s > 0 else 9
     fd = fa - _cog(q, cog, bases)
     if p[3] > 0.5:
         zd, F = lugre_rates(v, z, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4], p[14], p[15], 0.0)
         return v, (fd - F) / p[0], zd
-    F = s * stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3]) + p[base + 4] * v
-    return v, (fd - F) / p[0], 0.0
+    g = stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3])
+    if p[16] > 0.0:
+        return v, (fd - s * z - p[base + 4] * v) / p[0], (g - z) / p[16]
+    return v, (fd - s * g - p[base + 4] * v) / p[0], 0.0
 
 
 @numba.njit(cache=True, error_model="numpy", inline="always")
@@ -144,14 +152,17 @@ def _rk4(q, v, z, s, fa, h, p, cog, bases):
 @numba.njit(cache=True, error_model="numpy", nogil=True)
 def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
           v_out, stuck_out):
-    """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev] (updated in
-    place). Returns the number of samples done (< r.size when the state stopped being finite)."""
+    """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev, rest time]
+    (updated in place). Returns the number of samples done (< r.size when the state stopped being
+    finite). The break-away force after a rest of t_r is Fs + dwell level + gain (1 - exp(-t_r /
+    time)) (p[17:20]); the controller output is quantized to ctrl[9] when that is > 0."""
     h = dt / substeps
     lugre = p[3] > 0.5
     hold = int(ctrl[8])
     u = u_init
     uc = 0.0
     q, v, z, stuck = x[0], x[1], x[2], x[3] > 0.5
+    t_rest = x[9]
     for k in range(r.size):
         qm = q + noise[k]
         y = resolution * math.floor(qm / resolution + 0.5) if resolution > 0.0 else qm
@@ -174,6 +185,8 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
             u = ctrl[7]
         elif u < -ctrl[7]:
             u = -ctrl[7]
+        if ctrl[9] > 0.0:                  # the DAC's step
+            u = ctrl[9] * math.floor(u / ctrl[9] + 0.5)
         q_out[k] = y
         u_out[k] = u
         v_out[k] = v
@@ -189,28 +202,36 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
             for _ in range(3):             # a substep holds at most a stop and a restart
                 if stuck:
                     need = fa - _cog(q, cog, bases)
-                    if -p[10] <= need <= p[5]:
+                    grow = p[17] + (p[18] * (1.0 - math.exp(-t_rest / p[19])) if p[19] > 0.0 else 0.0)
+                    if -(p[10] + grow) <= need <= p[5] + grow:
+                        t_rest += rem
+                        if p[16] > 0.0:    # the lagging level relaxes to Fs at rest
+                            fs = p[5] if need >= 0.0 else p[10]
+                            z = fs + (z - fs) * math.exp(-rem / p[16])
                         break              # friction holds the mass
                     stuck = False
                     s = 1.0 if need > 0.0 else -1.0
                 else:
                     s = 1.0 if v > 0.0 else -1.0
-                qn, vn, _ = _rk4(q, v, 0.0, s, fa, rem, p, cog, bases)
+                qn, vn, zn = _rk4(q, v, z, s, fa, rem, p, cog, bases)
                 if s * vn > 0.0:
-                    q, v = qn, vn
+                    q, v, z = qn, vn, zn
                     break
                 # the velocity reaches zero inside: stop there (v linear in time), then decide
                 # stick or slip for the rest of the substep
                 th = s * v / (s * v - s * vn) if s * v - s * vn > 0.0 else 1.0
                 q = q + th * (qn - q)
+                z = z + th * (zn - z)
                 v = 0.0
                 stuck = True
+                t_rest = 0.0
                 rem *= 1.0 - th
                 if rem <= 0.0:
                     break
         if not (math.isfinite(q) and math.isfinite(v) and math.isfinite(z)):
             return k
     x[0], x[1], x[2], x[3] = q, v, z, 1.0 if stuck else 0.0
+    x[9] = t_rest
     return r.size
 
 
@@ -218,8 +239,10 @@ def model_arrays(model: NominalModel):
     """(p, cog, bases): the flat parameter vector and the cogging components' encodings
     (concatenated; component i starts at bases[i]) of a NominalModel, as the kernel reads them."""
     law = 1.0 if model.law == "lugre" else 0.0
+    dw = model.dwell
     p = np.array([model.mass, model.cm, model.offset, law, *model.curve.positive.encoded(),
-                  *model.curve.negative.encoded(), model.sigma0 or 0.0, model.sigma1 or 0.0])
+                  *model.curve.negative.encoded(), model.sigma0 or 0.0, model.sigma1 or 0.0, model.lag,
+                  *((dw.level, dw.gain, dw.time) if dw is not None else (0.0, 0.0, 0.0))])
     blocks = [c.encoded() for c in model.cogging] or [np.zeros(3)]
     bases = np.cumsum([0] + [b.size for b in blocks[:-1]]).astype(np.int64)
     if not model.cogging:
@@ -257,11 +280,6 @@ def resolution_of(q: np.ndarray) -> float:
         counts = d / step
         if np.mean(np.abs(counts - np.round(counts)) < 0.02) > 0.95:
             return step
-    return 0.0
-    step = float(np.percentile(d, 1))
-    counts = d / step
-    if np.mean(np.abs(counts - np.round(counts)) < 0.02) > 0.95:
-        return step
     return 0.0
 
 
@@ -312,8 +330,13 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
         pos, neg = model.curve.positive, model.curve.negative
         need = model.cm * u0 + fext[0] - model.offset - float(model.cogging_force(q0))
         z0 = float(np.clip(need, -0.99 * neg.Fs, 0.99 * pos.Fs)) / model.sigma0 if at_rest else 0.0
+    elif model.lag > 0:
+        # the lagging Stribeck level starts where it settles: Fs at rest, g(|v0|) when moving
+        c0 = model.curve.positive if v0 >= 0 else model.curve.negative
+        z0 = c0.Fs if at_rest else float(c0.level(np.array([abs(v0)]))[0])
+    # a record that starts at rest has rested long before it (the dwell effect fully grown)
     x = np.array([q0, 0.0 if at_rest else v0, z0, 1.0 if (at_rest and model.law != "lugre") else 0.0,
-                  I0, 0.0, sig0, q0, q0])
+                  I0, 0.0, sig0, q0, q0, 1e9])
     if x0 is not None:
         x0 = np.asarray(x0, float)
         if x0.shape != (3,) or not np.all(np.isfinite(x0)):

@@ -7,8 +7,13 @@ p < alpha, with the degrees of freedom reduced to the effective number of indepe
 n (1 - rho1) / (1 + rho1), rho1 the lag-1 autocorrelation of the extended model's residual,
 because smoothed residuals are far from white), and (2) it lowers the RMS residual on the validation data by at
 least ``min_gain`` (relative). Hyper-parameters (a cogging pitch, a Stribeck velocity) are chosen
-on the fitting data only. Causes are ranked by how much the validation RMS grows when each is
-dropped from the final extended model.
+on the fitting data only. Causes are ranked by their score: how much the validation metric grows
+when each is dropped from the final extended model (force channel), or nominal / extended - 1 of
+the cause's own validation metric (other channels).
+
+Causes with their own evidence (``CHANNEL = "own"``: dwell, saturation, quantization) bring a
+statistic with its p-value and a validation metric of their own (module docstrings); the same
+alpha and min_gain decide.
 
 Stick-channel causes (``CHANNEL = "stick"``, e.g. presliding) are judged on the samples where the
 (force-extended) model says the mass sticks: a chi-square test of the motion there against the
@@ -59,7 +64,7 @@ class Cause:
 
 @dataclass
 class Diagnosis:
-    """causes : ranked list of Cause (force channel first, then stick channel); nominal /
+    """causes : list of Cause ranked by score over all channels; nominal /
     extended : validation force-residual RMS [N] (None when the force channel was skipped);
     criterion : the selection rule; kin_fit, kin_val : kinematics; r_* : residuals (n,) of the
     nominal and extended model on both sets (NaN where not used: |v| small or filter edges);
@@ -163,6 +168,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     crit = CRITERION.format(alpha=alpha, min_gain=min_gain)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
+    own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
     notes: list = []
     nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
     # sliding samples: |v| above 2 % of the maximum and above the model's stick speed (creep in
@@ -185,6 +191,18 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             result.append(cause)
         elif row is not None:
             rejected.append(row)
+    if own_names:
+        from .resimulate import resolution_of
+        res = model.resolution if model.resolution is not None else resolution_of(fit.q)
+        for name in own_names:
+            cause, row, ext = _own_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim, res)
+            if cause is not None:
+                result.append(cause)
+            else:
+                rejected.append(row)
+    # one ranking over the channels: the relative worsening of each cause's own validation metric
+    # without it
+    result.sort(key=lambda c: -c.score)
     view, sims = None, None
     if behaviour and model.controller is not None and validate.q_ref is not None:
         from .behaviour import compare
@@ -311,6 +329,23 @@ def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
                     for k, v in alone.items() if k not in picked]
     return dict(causes=result, nominal=_rms(rv0), extended=_rms(rv_ext), rejected=rejected, alternatives=alternatives,
                 model=ext, r_fit=rf_full, r_val_nom=rvn, r_val_ext=rve)
+
+
+def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolution):
+    """Judge a cause with its own evidence and gain (``CHANNEL = "own"``: dwell, saturation,
+    quantization): its ``judge`` returns the statistic, p-value, fitted parameters and the
+    validation metric nominal / extended, or a reason; accepted when p < alpha and the metric
+    falls by at least min_gain. Returns (Cause or None, rejected row or None, model)."""
+    v = mod.judge(fit, val, kf, kv, model, can_sim, resolution)
+    row = dict(name=mod.NAME, step="own", statistic=v.get("statistic"), p_value=v.get("p_value"))
+    if "reason" in v:
+        return None, dict(row, validation_gain=None, reason=v["reason"]), model
+    gain = 1 - v["extended"] / max(v["nominal"], 1e-300)
+    if v["p_value"] >= alpha or gain < min_gain:
+        return None, dict(row, validation_gain=gain), model
+    return (Cause(mod.NAME, v["nominal"] / max(v["extended"], 1e-300) - 1, v["statistic"], v["p_value"],
+                  v["parameters"], v["sigma"], dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"])),
+            None, v["model"])
 
 
 def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):

@@ -1,10 +1,12 @@
 """Synthetic "measured" data with hidden effects, for tests that call the diagnosis blind.
 
 The true plant: m q'' = cm u(t - delay) + f_ext - F(q') - offset - F_cog(q), with Coulomb +
-viscous friction per direction (Fc+-, b+-; exact stick), F_cog = A sin(2 pi q / pitch), a
-random force disturbance; a 1 kHz PD position-velocity loop like the EMPS benchmark
-(u = kv (kp (q_ref - q) - v_f), v_f a backward difference of a 2-tap averaged position,
-saturation at 10 V) tracks bang-bang strokes; the encoder quantizes q. The loop is simulated by
+viscous friction per direction (Fc+-, b+-; exact stick), optionally a Stribeck level (Fs, vs)
+with frictional memory (lag) and a dwell-time growth of the break-away force,
+F_cog = A sin(2 pi q / pitch), a random force disturbance; a 1 kHz PD position-velocity loop like
+the EMPS benchmark (u = kv (kp (q_ref - q) - v_f), v_f a backward difference of a 2-tap averaged
+position, saturation at ``saturation`` V, optionally a DAC step) tracks bang-bang strokes with
+rests between them; the encoder quantizes q. The loop is simulated by
 :func:`hunting.diagnose.resimulate.resimulate` (the same sampled-loop engine as the behaviour view).
 """
 from __future__ import annotations
@@ -16,7 +18,7 @@ import numpy as np
 from ..models.friction import DirectionalCurve, StribeckCurve
 from ..models.plant import Cogging
 from .data import Measurement
-from .model import NominalModel
+from .model import Dwell, NominalModel
 from .resimulate import resimulate
 
 
@@ -39,11 +41,23 @@ class TruePlant:
     fs: float = 1000.0
     resolution: float = 1e-6
     force_noise: float = 0.5
+    Fs: float | None = None          # Stribeck level at rest (both directions; None: Fc, no dip)
+    vs: float = 0.01
+    lag: float = 0.0
+    dwell_gain: float = 0.0
+    dwell_time: float = 1.0
+    saturation: float = 10.0
+    dac_step: float = 0.0
+    rest: tuple = (0.2, 0.2)         # range of the rests between strokes [s]
+    stroke_speed: tuple = (0.05, 0.15)   # range of the strokes' mean speeds [m/s]
+    stroke: float = 0.2              # longest stroke [m]
 
 
-def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0) -> np.ndarray:
+def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0, rest=(0.2, 0.2),
+              speed=(0.05, 0.15)) -> np.ndarray:
     """Reference: strokes of random length (30-100 % of ``stroke``) with bang-bang acceleration
-    profiles and random peak speeds, dwelling 0.2 s between them."""
+    profiles and random mean speeds (uniform in ``speed`` [m/s]), resting between them for a time
+    log-uniform in ``rest`` [s] (many short rests and some long ones)."""
     rng = np.random.default_rng(seed)
     t = np.arange(0.0, duration, 1.0 / fs)
     r = np.zeros_like(t)
@@ -54,7 +68,7 @@ def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0) ->
         if abs(target - pos) < 1e-3:
             target = stroke - pos
         D = target - pos
-        T = max(abs(D) / rng.uniform(0.05, 0.15) * 2.0, 0.2)
+        T = max(abs(D) / rng.uniform(*speed) * 2.0, 0.2)
         n = int(T * fs)
         s = np.linspace(0, 1, n)
         prof = np.where(s < 0.5, 2 * s ** 2, 1 - 2 * (1 - s) ** 2)
@@ -62,7 +76,7 @@ def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0) ->
         r[k:k + n] = seg[: max(0, min(n, t.size - k))]
         k += n
         pos = target
-        nd = int(0.2 * fs)
+        nd = int((rest[0] if rest[0] == rest[1] else np.exp(rng.uniform(*np.log(rest)))) * fs)
         r[k:k + nd] = pos
         k += nd
     return r
@@ -70,17 +84,22 @@ def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0) ->
 
 def true_model(true: TruePlant) -> NominalModel:
     """The true plant and its controller as a NominalModel (what a perfect diagnosis recovers)."""
-    curve = DirectionalCurve(StribeckCurve(true.Fc_pos, true.Fc_pos, b=true.b_pos),
-                             StribeckCurve(true.Fc_neg, true.Fc_neg, b=true.b_neg))
+    dip = (true.Fs or 0.0) - true.Fc_pos if true.Fs is not None else 0.0
+    curve = DirectionalCurve(StribeckCurve(true.Fc_pos, true.Fc_pos + dip, vs=true.vs, b=true.b_pos),
+                             StribeckCurve(true.Fc_neg, true.Fc_neg + dip, vs=true.vs, b=true.b_neg))
     cog = (Cogging.sine(true.cog_amplitude, true.cog_pitch),) if true.cog_amplitude else ()
-    ctrl = {"type": "pd-velocity-loop", "kp": true.kp, "kv": true.kv, "sample_time": 1.0 / true.fs, "saturation": 10.0}
-    return NominalModel(true.mass, true.cm, curve, "coulomb-viscous", offset=true.offset, controller=ctrl,
-                        cogging=cog, delay=true.delay)
+    ctrl = {"type": "pd-velocity-loop", "kp": true.kp, "kv": true.kv, "sample_time": 1.0 / true.fs,
+            "saturation": true.saturation}
+    if true.dac_step:
+        ctrl["output_resolution"] = true.dac_step
+    dwell = Dwell(0.0, true.dwell_gain, true.dwell_time) if true.dwell_gain else None
+    return NominalModel(true.mass, true.cm, curve, "stribeck" if dip else "coulomb-viscous", offset=true.offset,
+                        controller=ctrl, cogging=cog, delay=true.delay, lag=true.lag, dwell=dwell)
 
 
 def generate(true: TruePlant, duration: float = 20.0, seed: int = 0, substeps: int = 10) -> Measurement:
     """A run of the true plant tracking bang-bang strokes; q quantized, u recorded."""
-    r = bang_bang(true.fs, duration, seed=seed)
+    r = bang_bang(true.fs, duration, true.stroke, seed=seed, rest=true.rest, speed=true.stroke_speed)
     noise = np.random.default_rng(seed + 1).normal(0.0, true.force_noise, r.size)
     t = np.arange(r.size) / true.fs
     template = Measurement(t, np.full(r.size, r[0]), np.zeros(r.size), q_ref=r, name=f"synthetic(seed={seed})")

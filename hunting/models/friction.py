@@ -124,6 +124,12 @@ class StribeckCurve:
         Fc, Fs, vs, beta, _ = self.encoded()
         return np.vectorize(lambda a: stribeck_level(a, Fc, Fs, vs, beta), otypes=[float])(v)
 
+    def level_slope(self, v) -> np.ndarray:
+        """d g / d|v| [N s/m] of the Stribeck level at speeds |v|."""
+        v = np.abs(np.asarray(v, dtype=float))
+        Fc, Fs, vs, beta, _ = self.encoded()
+        return np.vectorize(lambda a: stribeck_level_slope(a, Fc, Fs, vs, beta), otypes=[float])(v)
+
     def force(self, v) -> np.ndarray:
         """Slip friction force [N] for velocities v (array); 0 where v == 0 (see stick_set)."""
         return DirectionalCurve(self, self).force(v)

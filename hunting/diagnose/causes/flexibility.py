@@ -49,9 +49,11 @@ def hypers(kin, model) -> list:
     for i in idx:
         grid = [(np.log(fb[i] * s), np.log(zeta)) for s in np.linspace(0.8, 1.2, 11) for zeta in DAMPING]
         z0 = min(grid, key=ss)
-        res = minimize(ss, z0, method="Nelder-Mead", options=dict(xatol=1e-4, fatol=1e-10, maxiter=200))
         if not np.isfinite(ss(z0)):
             continue                                  # no positive load mass fits near this peak
+        # outside the admissible set: a finite penalty (inf - inf would be NaN in the simplex test)
+        res = minimize(lambda z: min(ss(z), 1e6 * ss(z0)), z0, method="Nelder-Mead",
+                       options=dict(xatol=1e-4, fatol=1e-10, maxiter=200))
         z = res.x if res.fun <= ss(z0) else z0
         out.append({"frequency": float(np.exp(z[0])), "damping": float(np.exp(z[1]))})
     return out

@@ -1,0 +1,117 @@
+"""Dwell-time effect: the break-away force grows with the time the contact has rested (Kato; the
+thesis' time-varying friction of Fig. 8.1). A break-away channel cause, judged on rests and the
+force at which each one ends.
+
+Rests are read from the measured positions (runs within two encoder counts for at least 30 ms,
+:func:`hunting.diagnose.behaviour.stick_phases`) that end in motion before the record does; the
+record's first rest is skipped (how long the contact rested before it is unknown). At rest a = 0,
+so the force friction carries at the end of a rest is F = cm u + f_ext - offset - F_cog(q)
+(u aligned for the zero-order hold, averaged over the 10 ms before the position is two counts
+from its rest value: the break-away lies in that span); its excess over the model's break-away force in
+the direction of the motion that follows is e_k. The extension fits
+
+    e_k = level + gain (1 - exp(-t_k / time))     (t_k the rest's duration)
+
+(level and gain linear, time on a logarithmic grid over the measured rests). Evidence: the F test
+of the time-dependent term against a constant level alone (a wrong Fs is a constant, not dwell),
+with 2 numerator degrees of freedom (gain and time). Gain: the RMS of e on the validation data's
+rests, nominal (the model's break-away force) against extended."""
+import numpy as np
+from scipy import stats
+
+NAME = "dwell"
+DESCRIPTION = "break-away force growing with the time at rest"
+CHANNEL = "own"
+MIN_RESTS = 6
+
+
+def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(t_rest [s], F [N], s) per rest that ends in motion: duration, the force friction carries
+    at its last sample, and the direction of the motion that follows (+1 / -1)."""
+    from ..behaviour import stick_phases
+    dt = meas.dt
+    phases = stick_phases(meas.q, dt, resolution)
+    u_at = np.concatenate([[meas.u[0]], 0.5 * (meas.u[1:] + meas.u[:-1])])
+    F = model.cm * u_at + meas.force_ext() - model.offset - model.cogging_force(meas.q)
+    tr, Fb, sd = [], [], []
+    ahead = max(int(round(0.05 / dt)), 2)
+    span = max(int(round(0.01 / dt)), 3)
+    for a, b in phases:
+        if a == 0 or b + ahead >= meas.n:
+            continue
+        q_rest = np.median(meas.q[a:b + 1])
+        moved = np.flatnonzero(np.abs(meas.q[a:b + ahead] - q_rest) > 1.5 * resolution)
+        moved = moved[moved > (b - a) // 2]
+        if moved.size == 0 or moved[0] - span < 0:
+            continue
+        m = a + int(moved[0])         # the first sample two counts away: motion has begun
+        tr.append((m - a) * dt)
+        # a digital loop's u is noisy (the velocity estimate of a quantized position); the
+        # break-away lies within the ~10 ms before the motion shows: average over that span
+        Fb.append(float(np.mean(F[m - span:m])))
+        sd.append(np.sign(meas.q[m] - q_rest))
+    return np.array(tr), np.array(Fb), np.array(sd)
+
+
+def excess(model, t, F, s) -> np.ndarray:
+    """e_k [N]: s F - the model's break-away force after rest t in direction s."""
+    Fs = np.where(s > 0, model.curve.positive.Fs, model.curve.negative.Fs)
+    pred = model.dwell.breakaway(Fs, t) if model.dwell is not None else Fs
+    return s * F - pred
+
+
+def _design(t, tau):
+    return np.column_stack([np.ones_like(t), 1 - np.exp(-t / tau)])
+
+
+def _ls(t, e, tau) -> tuple[float, np.ndarray]:
+    """(residual sum of squares, [level, gain]) at time constant tau."""
+    A = _design(t, tau)
+    th, *_ = np.linalg.lstsq(A, e, rcond=None)
+    return float(np.sum((e - A @ th) ** 2)), th
+
+
+def _fit(t, e):
+    """Best (ss, [level, gain], time) over the time grid, and the constant-only ss."""
+    grid = np.geomspace(0.2 * t.min(), 5 * t.max(), 41)
+    ss, th, tau = min(((*_ls(t, e, x), float(x)) for x in grid), key=lambda r: r[0])
+    return (ss, th, tau), float(np.sum((e - e.mean()) ** 2))
+
+
+def judge(fit, validate, kf, kv, model, can_sim, resolution):
+    """The verdict on dwell (module docstring): a dict with statistic, p_value, parameters,
+    sigma, metric, nominal, extended, model (the extended model) or reason (why not)."""
+    from ..model import Dwell
+    t, F, s = rests(fit, model, resolution)
+    if t.size < MIN_RESTS:
+        return dict(reason=f"{t.size} rests ending in motion in the fitting data (need {MIN_RESTS})")
+    if np.ptp(t) < 0.5 * np.mean(t):
+        return dict(reason=f"the rests all last about {np.mean(t):.3g} s: a dwell effect cannot be told from Fs")
+    e = excess(model, t, F, s)
+    (ss, th, tau), ss0 = _fit(t, e)
+    dof = t.size - 4
+    if dof < 1:
+        return dict(reason="too few rests for the F test")
+    Fstat = ((ss0 - ss) / 2) / max(ss / dof, 1e-300)
+    p = float(stats.f.sf(Fstat, 2, dof))
+    out = dict(statistic=float(Fstat), p_value=p)
+    if th[1] <= 0:
+        return dict(out, reason=f"the break-away force falls with the rest (gain {th[1]:.3g} N): not a dwell effect")
+    tv, Fv, sv = rests(validate, model, resolution)
+    if tv.size < 3:
+        return dict(out, reason=f"{tv.size} rests ending in motion in the validation data (need 3)")
+    base = model.dwell or Dwell(0.0, 0.0, tau)
+    ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau))
+    ev0, ev1 = excess(model, tv, Fv, sv), excess(ext, tv, Fv, sv)
+    A = _design(t, tau)
+    cov = np.linalg.pinv(A.T @ A) * ss / dof
+    # the time's standard uncertainty from the curvature of the residual sum of squares in tau
+    h = 0.05 * tau
+    ssp = [_ls(t, e, x)[0] for x in (tau - h, tau + h)]
+    curv = (ssp[0] - 2 * ss + ssp[1]) / h ** 2
+    sig_tau = float(np.sqrt(2 * ss / dof / curv)) if curv > 0 else None
+    d = ext.dwell
+    return dict(out, parameters={"level": d.level, "gain": d.gain, "time": d.time},
+                sigma={"level": float(np.sqrt(cov[0, 0])), "gain": float(np.sqrt(cov[1, 1])), "time": sig_tau},
+                metric="break-away force RMS error [N], validation rests",
+                nominal=float(np.sqrt(np.mean(ev0 ** 2))), extended=float(np.sqrt(np.mean(ev1 ** 2))), model=ext)
