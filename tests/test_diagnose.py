@@ -174,8 +174,11 @@ def test_emps_offset_and_asymmetry(shared_dir, tmp_path):
     model, _ = fit_coulomb_viscous(kinematics(fit, 35.15065188))
     model = model.replace(controller={"type": "pd-velocity-loop", "kp": 160.18, "kv": 243.45, "sample_time": 1e-3,
                                       "saturation": 10.0})
-    assert model.mass == pytest.approx(95.1089, rel=0.05)
-    assert model.curve.positive.b == pytest.approx(203.5034, rel=0.02)
+    # parallel filtering (force, friction regressors and acceleration through one filter) gives
+    # the published IDIM-LS values: 94.86 / 20.47 / 203.8 against 95.11 / 20.39 / 203.5
+    assert model.mass == pytest.approx(95.1089, rel=0.01)
+    assert model.curve.positive.Fc == pytest.approx(20.3935, rel=0.01)
+    assert model.curve.positive.b == pytest.approx(203.5034, rel=0.01)
     dg = diagnose(fit, model, val)
     asym = next(c for c in dg.causes if c.name == "asymmetry")
     assert asym.parameters["b_pos"] == pytest.approx(166.7061, rel=0.05)

@@ -356,3 +356,10 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
                          f"(now {substeps}) or check the model's parameters")
     m = n if ok else done
     return Simulation(meas.t[:m], qo[:m], uo[:m], vo[:m], so[:m], ok, msg)
+
+
+def position_rms_error(meas: Measurement, model: NominalModel) -> float:
+    """RMS [m] of the re-simulated positions of ``model`` against the measured ones (inf when the
+    re-simulation failed): the validation metric of the behaviour-channel causes."""
+    sim = resimulate(meas, model)
+    return float(np.sqrt(np.mean((sim.q - meas.q[:sim.q.size]) ** 2))) if sim.ok else np.inf

@@ -351,7 +351,7 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
 def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     """Judge one stick-channel cause (module docstring). Returns (Cause or None, rejected row or
     None, the model extended by it when accepted)."""
-    from .resimulate import resimulate, resolution_of
+    from .resimulate import position_rms_error, resolution_of
     segs = mod.segments(kf, model)
     if sum(b - a + 1 for a, b in segs) < 200:
         return None, None, model
@@ -369,10 +369,7 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     except SystemDefinitionError as exc:           # e.g. a negative fitted compliance
         return reject(reason=f"the fitted extension is not physical: {exc}")
     if can_sim:
-        def err(m):
-            sim = resimulate(val, m)
-            return float(np.sqrt(np.mean((sim.q - val.q[:sim.q.size]) ** 2)))
-        before, after = err(model), err(ext)
+        before, after = position_rms_error(val, model), position_rms_error(val, ext)
         metric = "re-simulated position RMS error [m], validation"
     else:
         sv = mod.segments(kv, model)

@@ -5,7 +5,6 @@ follows the Stribeck level g(|v|) through a first-order lag of time constant ``l
 -lag g'(|v|) a: lower than the static curve while accelerating out of the Stribeck dip, higher
 while decelerating into it. A curve without a dip (Fs = Fc) has no level to lag, and the cause
 does not apply. The re-simulation integrates the lag exactly."""
-import numpy as np
 
 NAME = "lag"
 DESCRIPTION = "frictional memory: the Stribeck level lags the velocity (time constant)"

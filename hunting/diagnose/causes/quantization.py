@@ -25,7 +25,7 @@ def _on_grid(x: np.ndarray, step: float) -> tuple[int, int]:
 
 
 def judge(fit, validate, kf, kv, model, can_sim, resolution):
-    from ..resimulate import resimulate, resolution_of
+    from ..resimulate import position_rms_error, resolution_of
     ctrl = model.controller or {}
     du = resolution_of(fit.u if fit.u_inj is None else fit.u - fit.u_inj)
     dac_model = float(ctrl.get("output_resolution", 0.0))
@@ -49,10 +49,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         ext = ext.replace(controller=dict(ctrl, output_resolution=du))
     if "sensor_resolution" in changes:
         ext = ext.replace(resolution=dq)
-
-    def err(m):
-        sim = resimulate(validate, m)
-        return float(np.sqrt(np.mean((sim.q - validate.q[:sim.q.size]) ** 2))) if sim.ok else np.inf
     return dict(out, parameters=changes, sigma={k: None for k in changes},
-                metric="re-simulated position RMS error [m], validation", nominal=err(model), extended=err(ext),
+                metric="re-simulated position RMS error [m], validation", nominal=position_rms_error(validate, model),
+                extended=position_rms_error(validate, ext),
                 model=ext)

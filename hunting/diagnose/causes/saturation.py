@@ -31,7 +31,7 @@ def bound_runs(u: np.ndarray) -> tuple[float, int, float]:
 
 
 def judge(fit, validate, kf, kv, model, can_sim, resolution):
-    from ..resimulate import resimulate
+    from ..resimulate import position_rms_error
     U, run, frac = bound_runs(fit.u)
     p = float(frac ** (run - 1)) if run > 1 else 1.0
     out = dict(statistic=float(run), p_value=p)
@@ -43,10 +43,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     if not can_sim:
         return dict(out, reason="the gain needs re-simulation: the model's controller and the reference q_ref")
     ext = model.replace(controller=dict(model.controller, saturation=U))
-
-    def err(m):
-        sim = resimulate(validate, m)
-        return float(np.sqrt(np.mean((sim.q - validate.q[:sim.q.size]) ** 2))) if sim.ok else np.inf
     return dict(out, parameters={"saturation": U}, sigma={"saturation": None},
-                metric="re-simulated position RMS error [m], validation", nominal=err(model), extended=err(ext),
+                metric="re-simulated position RMS error [m], validation", nominal=position_rms_error(validate, model),
+                extended=position_rms_error(validate, ext),
                 model=ext)
