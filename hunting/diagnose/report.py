@@ -85,7 +85,12 @@ def write_report(dg: Diagnosis, directory) -> Path:
     rows = "".join(
         f"<tr><td>{i + 1}</td><td>{html.escape(c.name)}</td><td>{c.score:.3g}</td><td>{c.p_value:.2g}</td>"
         f"<td>{html.escape(', '.join(f'{k} = {v:.4g}' + _pm(c.sigma.get(k)) for k, v in c.parameters.items()))}</td>"
-        f"<td>{c.gain['nominal']:.4g} → {c.gain['extended']:.4g}</td></tr>" for i, c in enumerate(dg.causes))
+        f"<td>{html.escape(c.gain['metric'])}: {c.gain['nominal']:.4g} → {c.gain['extended']:.4g}</td></tr>"
+        for i, c in enumerate(dg.causes))
+    rej = "".join(f"<li>{html.escape(r['name'])}: " + html.escape(
+        r.get("reason") or f"p = {r.get('p_value', float('nan')):.2g}, validation gain = "
+        f"{r.get('validation_gain') if r.get('validation_gain') is None else format(r['validation_gain'], '.2%')}")
+        + "</li>" for r in dg.rejected)
     alt = "".join(f"<li>{html.escape(a['name'])}: {html.escape(str(a['parameters']))} (absorbed by "
                   f"{html.escape(', '.join(a['absorbed_by']))})</li>" for a in dg.alternatives)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>hunting diagnosis</title></head><body>
@@ -94,8 +99,9 @@ def write_report(dg: Diagnosis, directory) -> Path:
 {'<ul>' + notes + '</ul>' if notes else ''}
 <p>Criterion: {html.escape(dg.criterion)}.</p>
 <table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
-<th>validation RMS [N]</th></tr>{rows}</table>
+<th>validation metric: nominal → extended</th></tr>{rows}</table>
 {'<h2>Alternatives</h2><ul>' + alt + '</ul>' if alt else ''}
+{'<h2>Not reported (why)</h2><ul>' + rej + '</ul>' if rej else ''}
 {''.join(f'<img src="{i}" width="720"><br>' for i in imgs)}</body></html>"""
     (d / "index.html").write_text(page)
     return d / "index.html"

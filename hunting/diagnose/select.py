@@ -248,10 +248,6 @@ def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
             ss_min = min(f[0] for f in fits)
             ss1, df, dv, hyper, t2 = next(f for f in fits if f[0] <= ss_min * (1 + 1e-3))
             k = df.shape[1]
-            why = getattr(CAUSES[name], "unphysical", lambda *a: None)(t2[Pf.shape[1]:], hyper, model)
-            if why:
-                rejected.append(dict(name=name, step=len(chosen) + 1, reason=f"the fitted extension is not physical: {why}"))
-                continue
             # effective sample size from the residual of the extended fit (the residual before it
             # is dominated by the very effect being tested, e.g. a smooth cogging force)
             r1 = rf0 - np.column_stack([Pf, df]) @ t2
@@ -261,7 +257,11 @@ def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
             rms_v = _rms(rv0 - np.column_stack([Pv, dv]) @ t2)
             gain = 1 - rms_v / _rms(rv_cur)
             row = (name, df, dv, hyper, float(F), p, _rms(rv_cur), rms_v, gain)
-            if p < alpha and gain >= min_gain:
+            why = getattr(CAUSES[name], "unphysical", lambda *a: None)(t2[Pf.shape[1]:], hyper, model)
+            if p < alpha and gain >= min_gain and why:
+                rejected.append(dict(name=name, step=len(chosen) + 1, F=float(F), p_value=p, validation_gain=gain,
+                                     reason=f"the fitted extension is not physical: {why}"))
+            elif p < alpha and gain >= min_gain:
                 if not chosen:
                     alone[name] = (CAUSES[name].parameters(t2, hyper, model),
                                    dict(metric="force residual RMS [N], validation, alone", nominal=_rms(rv_cur),
