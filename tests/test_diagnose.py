@@ -15,8 +15,11 @@ NOMINAL = {"plant": {"mass": 95.0, "motor_constant": 35.15},
            "friction": {"law": "coulomb-viscous", "Fc": 20.0, "b": 200.0}}
 
 
-def _run(true, seeds=(1, 2)):
-    return diagnose(generate(true, seed=seeds[0]), NominalModel.from_dict(NOMINAL), generate(true, seed=seeds[1]))
+def _run(true, seeds=(1, 2), nominal=None, duration=20.0):
+    """Diagnose a fitting and a validation run of ``true`` (seeds) against ``nominal`` (default
+    the Coulomb + viscous NOMINAL without controller)."""
+    nominal = NominalModel.from_dict(NOMINAL) if nominal is None else nominal
+    return diagnose(generate(true, duration, seed=seeds[0]), nominal, generate(true, duration, seed=seeds[1]))
 
 
 def test_clean_data_gives_no_cause():
@@ -114,15 +117,11 @@ def test_hidden_flexibility_is_found():
     assert NominalModel.from_dict(ext.to_dict()).flexibility == ext.flexibility     # schema round trip
 
 
-def _blind(true, nominal, duration=20.0):
-    return diagnose(generate(true, duration, seed=1), nominal, generate(true, duration, seed=2))
-
-
 def test_hidden_lag_is_found():
     """Frictional memory of the Stribeck level (20 ms) under a model with the right curve: lag
     first, its time constant within 25 % (the cause's first-order regressor reads it 15 % low)."""
     true = TruePlant(Fs=30.0, vs=0.01, lag=0.02)
-    dg = _blind(true, true_model(replace(true, lag=0.0)))
+    dg = _run(true, nominal=true_model(replace(true, lag=0.0)))
     c = dg.causes[0]
     assert c.name == "lag"
     assert c.parameters["lag"] == pytest.approx(0.02, rel=0.25)
@@ -135,7 +134,7 @@ def test_hidden_dwell_is_found():
     of 10 ms .. 3 s: dwell first, its growth recovered, the break-away forces of the validation
     run predicted at least twice as well."""
     true = TruePlant(dwell_gain=10.0, dwell_time=1.0, rest=(0.01, 3.0), stroke_speed=(0.01, 0.03), stroke=0.02)
-    dg = _blind(true, true_model(replace(true, dwell_gain=0.0)), duration=60.0)
+    dg = _run(true, nominal=true_model(replace(true, dwell_gain=0.0)), duration=60.0)
     c = dg.causes[0]
     assert c.name == "dwell"
     assert c.parameters["gain"] == pytest.approx(10.0, rel=0.5)
@@ -147,11 +146,11 @@ def test_hidden_saturation_and_dac_quantization_are_found():
     """Output saturation at 1.4 V (19 % of the samples) and, separately, a 0.05 V DAC step, both
     missing from the model: each found with its exact level, and the re-simulation improves."""
     nominal = true_model(TruePlant())
-    dg = _blind(TruePlant(saturation=1.4), nominal)
+    dg = _run(TruePlant(saturation=1.4), nominal=nominal)
     c = dg.causes[0]
     assert c.name == "saturation" and c.parameters["saturation"] == pytest.approx(1.4, rel=1e-6)
     assert c.gain["extended"] < 0.1 * c.gain["nominal"]
-    dg = _blind(TruePlant(dac_step=0.05), nominal)
+    dg = _run(TruePlant(dac_step=0.05), nominal=nominal)
     assert [c.name for c in dg.causes] == ["quantization"]
     assert dg.causes[0].parameters["output_resolution"] == pytest.approx(0.05, rel=1e-3)
     assert dg.extended_model.controller["output_resolution"] == pytest.approx(0.05, rel=1e-3)
@@ -159,7 +158,7 @@ def test_hidden_saturation_and_dac_quantization_are_found():
 
 def test_clean_data_with_the_controller_gives_no_cause():
     """The true model with its controller (all channels, re-simulation included) on clean data."""
-    dg = _blind(TruePlant(), true_model(TruePlant()))
+    dg = _run(TruePlant(), nominal=true_model(TruePlant()))
     assert dg.causes == []
 
 

@@ -108,3 +108,60 @@ def test_vectorized_cogging_matches_the_kernel_formula():
     m = NominalModel.from_dict({"plant": {"mass": 1.0, "cogging": {"pitch": 0.01, "cos": [1.0], "sin": [2.0]}},
                                 "friction": {"Fc": 1.0}})
     assert m.cogging_force(np.array([0.0025])) == pytest.approx([2.0])      # 1 cos(pi/2) + 2 sin(pi/2)
+
+
+def test_dwell_threshold_grows_with_the_rest_as_stated():
+    """A mass at rest from t0, pushed by 2 N until T and then by a slow ramp 2 + 10 (t - T) N: it
+    breaks away at the first t where the push reaches Fs + level + gain (1 - exp(-(t - t0) /
+    time)) (the rest still grows during the ramp; crossing found on a 1 us grid), for several T."""
+    dt = 1e-3
+    for T in (0.2, 1.0, 3.0):
+        n = int((T + 2.5) / dt)
+        t = np.arange(n) * dt
+        model = NominalModel.from_dict({"plant": {"mass": 1.0}, "controller": {"type": "pid", "kp": 0.0},
+                                        "friction": {"Fc": 5.0, "dwell": {"level": 0.5, "gain": 8.0, "time": 0.7}}})
+        f = np.where(t < T, 2.0, 2.0 + 10.0 * (t - T))
+        meas = _meas(n, dt, np.zeros(n), f)
+        sim = resimulate(meas, model, resolution=0.0, x0=(0.0, 1e-3, 0.0))   # moving at t = 0: rest from 0
+        # it stops at t0 = 1e-3 / 3 s (decelerating at 3 m/s^2); the rest counts from there
+        k_stop = int(np.argmax(sim.stuck))
+        k = k_stop + int(np.argmax(~sim.stuck[k_stop:]))
+        tt = np.arange(T, T + 2.5, 1e-6)
+        cross = tt[np.argmax(2.0 + 10.0 * (tt - T) >= 5.5 + 8.0 * (1 - np.exp(-(tt - 1e-3 / 3) / 0.7)))]
+        # the push is held per sample and the flag is the state at a sample's start: the first
+        # sample seen sliding is one or two after the crossing
+        assert cross < t[k] <= cross + 2 * dt
+        assert cross - T > 0.05                         # the growth during the rest mattered
+
+
+def test_lagging_stribeck_level_matches_solve_ivp():
+    """A constant 12 N push on a mass with a Stribeck curve (Fc 4, Fs 8, vs 0.05) and lag 30 ms,
+    sliding from v = 0.02 m/s: the kernel against solve_ivp of (q, v, L) with
+    L' = (g(v) - L) / lag, F = L + b v (no reversal, so no stick logic involved)."""
+    from scipy.integrate import solve_ivp
+    dt, n, m, b, lag = 1e-3, 800, 2.0, 3.0, 0.03
+    model = NominalModel.from_dict({"plant": {"mass": m}, "controller": {"type": "pid", "kp": 0.0},
+                                    "friction": {"law": "stribeck", "Fc": 4.0, "Fs": 8.0, "vs": 0.05, "b": b,
+                                                 "lag": lag}})
+    meas = _meas(n, dt, np.zeros(n), np.full(n, 12.0))
+    g = lambda v: 4.0 + 4.0 * np.exp(-(v / 0.05) ** 2)  # noqa: E731
+    L0 = float(g(0.02))
+    sim = resimulate(meas, model, resolution=0.0, x0=(0.0, 0.02, L0))
+    ref = solve_ivp(lambda _, y: [y[1], (12.0 - y[2] - b * y[1]) / m, (g(y[1]) - y[2]) / lag],
+                    (0.0, (n - 1) * dt), [0.0, 0.02, L0], t_eval=np.arange(n) * dt, rtol=1e-11, atol=1e-13)
+    assert np.max(np.abs(sim.q - ref.y[0])) < 1e-9 * np.max(np.abs(ref.y[0]))
+    # and the lag matters here: without it the motion differs by far more
+    free = resimulate(meas, model.replace(lag=0.0), resolution=0.0, x0=(0.0, 0.02, 0.0))
+    assert np.max(np.abs(free.q - ref.y[0])) > 1e-3 * np.max(np.abs(ref.y[0]))
+
+
+def test_dac_step_quantizes_the_controller_output():
+    n, dt = 500, 1e-3
+    r = 1e-3 * np.sin(2 * np.pi * 3 * np.arange(n) * dt)
+    ctrl = {"type": "pd-velocity-loop", "kp": 100.0, "kv": 50.0, "output_resolution": 0.01}
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 0.0, "b": 1.0}, "controller": ctrl})
+    sim = resimulate(_meas(n, dt, r), model, resolution=0.0)
+    assert np.allclose(sim.u / 0.01, np.round(sim.u / 0.01), atol=1e-9, rtol=0)
+    assert np.unique(sim.u).size > 10
+    with pytest.raises(SystemDefinitionError, match="output_resolution"):
+        SampledController.from_schema(dict(ctrl, output_resolution=-1.0))

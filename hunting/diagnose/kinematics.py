@@ -40,20 +40,17 @@ class Kinematics:
 
     def filtered(self, x: np.ndarray) -> np.ndarray:
         """x (n,) or (n, k) through the acceleration's filter (the one the force went through)."""
-        x = np.asarray(x, dtype=float)
-        if x.ndim == 2:
-            return np.column_stack([self.filtered(c) for c in x.T]) if x.shape[1] else x
         dt = float(self.t[1] - self.t[0])
-        return _acceleration_filter(x, dt, int(round(self.window / dt)))
+        return _acceleration_filter(np.asarray(x, dtype=float), dt, int(round(self.window / dt)))
 
 
 def _acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
-    """The low pass H_a of the SG second derivative (w samples, cubic) applied to x (n,): the
-    derivative filter on x's double (trapezoidal) integral (it annihilates the integration
-    constants, so the result is exactly H_a x)."""
-    m = float(np.mean(x))
-    x2 = cumulative_trapezoid(cumulative_trapezoid(x - m, dx=dt, initial=0.0), dx=dt, initial=0.0)
-    return savgol_filter(x2, w, 3, deriv=2, delta=dt, mode="interp") + m
+    """The low pass H_a of the SG second derivative (w samples, cubic) applied to x (n,) or to
+    each column of x (n, k): the derivative filter on x's double (trapezoidal) integral (it
+    annihilates the integration constants, so the result is exactly H_a x)."""
+    m = np.mean(x, axis=0)
+    x2 = cumulative_trapezoid(cumulative_trapezoid(x - m, dx=dt, axis=0, initial=0.0), dx=dt, axis=0, initial=0.0)
+    return savgol_filter(x2, w, 3, deriv=2, delta=dt, mode="interp", axis=0) + m
 
 
 def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_min_frac: float = 0.02) -> Kinematics:

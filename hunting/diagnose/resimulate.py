@@ -276,11 +276,17 @@ def resolution_of(q: np.ndarray) -> float:
         return 0.0
     smallest = float(np.partition(d, 4)[4])
     for divisor in range(1, 6):
-        step = smallest / divisor
-        counts = d / step
-        if np.mean(np.abs(counts - np.round(counts)) < 0.02) > 0.95:
-            return step
+        k, n = steps_on_grid(q, smallest / divisor)
+        if k > 0.95 * n:
+            return smallest / divisor
     return 0.0
+
+
+def steps_on_grid(x: np.ndarray, step: float) -> tuple[int, int]:
+    """(k, n): of the n nonzero steps of x (n,), k are integer multiples of ``step`` (within 2 %)."""
+    d = np.abs(np.diff(x))
+    c = d[d > 1e-15] / step
+    return int(np.sum(np.abs(c - np.round(c)) < 0.02)), int(c.size)
 
 
 def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | None = None,

@@ -84,7 +84,7 @@ def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0, re
 
 def true_model(true: TruePlant) -> NominalModel:
     """The true plant and its controller as a NominalModel (what a perfect diagnosis recovers)."""
-    dip = (true.Fs or 0.0) - true.Fc_pos if true.Fs is not None else 0.0
+    dip = 0.0 if true.Fs is None else true.Fs - true.Fc_pos
     curve = DirectionalCurve(StribeckCurve(true.Fc_pos, true.Fc_pos + dip, vs=true.vs, b=true.b_pos),
                              StribeckCurve(true.Fc_neg, true.Fc_neg + dip, vs=true.vs, b=true.b_neg))
     cog = (Cogging.sine(true.cog_amplitude, true.cog_pitch),) if true.cog_amplitude else ()

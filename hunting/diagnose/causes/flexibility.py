@@ -52,7 +52,8 @@ def hypers(kin, model) -> list:
         if not np.isfinite(ss(z0)):
             continue                                  # no positive load mass fits near this peak
         # outside the admissible set: a finite penalty (inf - inf would be NaN in the simplex test)
-        res = minimize(lambda z: min(ss(z), 1e6 * ss(z0)), z0, method="Nelder-Mead",
+        cap = 1e6 * ss(z0)
+        res = minimize(lambda z: min(ss(z), cap), z0, method="Nelder-Mead",
                        options=dict(xatol=1e-4, fatol=1e-10, maxiter=200))
         z = res.x if res.fun <= ss(z0) else z0
         out.append({"frequency": float(np.exp(z[0])), "damping": float(np.exp(z[1]))})
@@ -62,6 +63,10 @@ def hypers(kin, model) -> list:
 def design(kin, model, hyper):
     dt = float(kin.t[1] - kin.t[0])
     return -highpass_response(kin.a, dt, hyper["frequency"], hyper["damping"])[:, None]
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    return f"load mass {theta[0]:.3g} kg <= 0" if theta[0] <= 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:

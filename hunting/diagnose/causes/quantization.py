@@ -17,26 +17,19 @@ DESCRIPTION = "controller output (DAC) or sensor quantization different from the
 CHANNEL = "own"
 
 
-def _on_grid(x: np.ndarray, step: float) -> tuple[int, int]:
-    d = np.abs(np.diff(x))
-    d = d[d > 1e-15]
-    c = d / step
-    return int(np.sum(np.abs(c - np.round(c)) < 0.02)), int(d.size)
-
-
 def judge(fit, validate, kf, kv, model, can_sim, resolution):
-    from ..resimulate import position_rms_error, resolution_of
+    from ..resimulate import position_rms_error, resolution_of, steps_on_grid
     ctrl = model.controller or {}
     du = resolution_of(fit.u if fit.u_inj is None else fit.u - fit.u_inj)
     dac_model = float(ctrl.get("output_resolution", 0.0))
     dq, dq_model = resolution, model.resolution
     changes, stat, p = {}, 0.0, 1.0
     if du > 0 and abs(du - dac_model) > 0.01 * du:
-        k, n = _on_grid(fit.u, du)
+        k, n = steps_on_grid(fit.u, du)
         changes["output_resolution"] = du
         stat, p = k / n, float(stats.binom.sf(k - 1, n, 0.04))
     if dq_model is not None and dq > 0 and abs(dq - dq_model) > 0.01 * dq:
-        k, n = _on_grid(fit.q, dq)
+        k, n = steps_on_grid(fit.q, dq)
         changes["sensor_resolution"] = dq
         stat, p = max(stat, k / n), min(p, float(stats.binom.sf(k - 1, n, 0.04)))
     out = dict(statistic=stat, p_value=p)
