@@ -9,7 +9,6 @@ there with probability 0.04, and the binomial tail of the observed count is the 
 extension sets the controller's ``output_resolution`` and the sensor resolution to the data's; its
 gain is the fall of the re-simulated position RMS error on the validation data (needs the
 controller and the reference)."""
-import numpy as np
 from scipy import stats
 
 NAME = "quantization"
