@@ -23,6 +23,7 @@ taken from the mode, not from ``x``): events are then located on smooth interpol
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
 
@@ -58,6 +59,13 @@ MODE_KINDS = ("smooth", "stick", "filippov")
 def no_jacobian(mode, t, x, p, out):  # pragma: no cover - placeholder passed when finite differences are used
     """Stand-in for systems without an analytic Jacobian (the kernels then use differences)."""
     out[:, :] = 0.0
+
+
+def _require_finite(p: np.ndarray, names: tuple) -> None:
+    """Raise naming every non-finite entry of a flat parameter array."""
+    if not np.all(np.isfinite(p)):
+        bad = [names[i] if i < len(names) else f"params[{i}]" for i in np.flatnonzero(~np.isfinite(p))]
+        raise SystemDefinitionError(f"parameters {bad} are not finite")
 
 
 @dataclass(frozen=True)
@@ -149,10 +157,7 @@ class PiecewiseSystem:
         if len(p) < len(self.param_names):
             raise SystemDefinitionError(
                 f"params has {len(p)} entries but {len(self.param_names)} param_names")
-        if not np.all(np.isfinite(p)):
-            bad = [self.param_names[i] if i < len(self.param_names) else f"params[{i}]"
-                   for i in np.flatnonzero(~np.isfinite(p))]
-            raise SystemDefinitionError(f"parameters {bad} are not finite")
+        _require_finite(p, self.param_names)
         set_(self, "params", p)
         ng = max(1, len(self.guard_names))
         if self.directions is None:
@@ -219,11 +224,16 @@ class PiecewiseSystem:
         return replace(self, params=new)
 
     def with_param_array(self, params: Sequence[float]) -> "PiecewiseSystem":
-        """Copy with the whole flat parameter array replaced."""
-        p = np.asarray(params, dtype=np.float64)
+        """Copy with the whole flat parameter array replaced. Only the parameters are checked:
+        the rest was validated when this system was built (continuation calls this at every
+        flow, and re-validating the compiled functions cost ~0.1 ms each time)."""
+        p = np.ascontiguousarray(params, dtype=np.float64)
         if p.shape != self.params.shape:
             raise SystemDefinitionError(f"params has shape {p.shape}: expected {self.params.shape}")
-        return replace(self, params=p)
+        _require_finite(p, self.param_names)
+        new = copy.copy(self)
+        object.__setattr__(new, "params", p)
+        return new
 
     def evaluate(self, x, mode: int | None = None, t: float = 0.0) -> np.ndarray:
         """Vector field at one state (shape (n,)); mode from ``mode_of`` when not given."""

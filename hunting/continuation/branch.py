@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import Status, SystemDefinitionError
 from ..results import SpecialPoint
 from ..system import PiecewiseSystem
-from .flow import flow
+from .flow import Flow, flow
 from .shooting import PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude
 
 
@@ -36,10 +36,19 @@ class ContinuationOptions:
     being refined; chord_rate : slowest contraction of the residual accepted with a kept
     Jacobian (slower ones recompute it); max_correction : largest corrector move as a fraction
     of ds and max_angle [rad] the largest turn of the tangent in one step (larger ones halve
-    ds: no branch jumping); jacobian_rtol : rtol of the flows with sensitivities recomputed
-    inside the corrector (they only steer it). Residual flows run at min(shooting rtol,
-    newton_tol / 100), each converged point's Jacobian (multipliers, tangent) at 100 times
-    that."""
+    ds: no branch jumping); jacobian_reuse : the corrector takes a Jacobian flow at its first
+    iterate with scaled residual at most this, and a converged point within this distance
+    (max-norm, scaled units) of the iterate of the corrector's last Jacobian flow keeps that
+    Jacobian for its multipliers and tangent (else it gets a flow of its own; with 1e-6 the
+    multipliers on the chapter-8 LuGre branch stay within 4e-4 of flows at rtol 1e-11, as
+    without reuse: near the fold they are that sensitive); jacobian_method : integration method of the flows with
+    sensitivities (None: the shooting method; "radau" for stiff loops such as LuGre: its
+    variational stages are solved exactly with the stage Jacobians, at about half the cost of
+    DOP853 there); trivial_tol : a point whose trivial multiplier is further than this (or
+    1e3 newton_tol) from 1, relative to max(1, |lambda_2|), gets its Jacobian again, at the
+    point, with the shooting method and Phi under its error control (near a fold two
+    multipliers meet at 1 and their errors grow like the square root of Phi's). Flows without sensitivities run at rtol = min(shooting rtol,
+    newton_tol / 100), flows with sensitivities at 100 times that."""
 
     ds: float = 0.05
     ds_min: float = 1e-6
@@ -53,14 +62,19 @@ class ContinuationOptions:
     max_correction: float = 0.3
     step_tol: float = 1e-10
     max_angle: float = 0.15
-    jacobian_rtol: float = 1e-7
+    jacobian_reuse: float = 1e-6
+    jacobian_method: str | None = None
+    trivial_tol: float = 1e-4
     quadratic_predictor: bool = True
 
     def __post_init__(self):
-        for name in ("ds", "ds_min", "ds_max", "newton_tol", "dmu", "fold_tol"):
+        for name in ("ds", "ds_min", "ds_max", "newton_tol", "dmu", "fold_tol", "jacobian_reuse", "trivial_tol"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise SystemDefinitionError(f"{name} = {v!r} is not allowed: it must be a finite number > 0")
+        if self.jacobian_method not in (None, "dop853", "dp5", "radau"):
+            raise SystemDefinitionError(f"jacobian_method = {self.jacobian_method!r} is not allowed: "
+                                        f"use None, 'dop853', 'dp5' or 'radau'")
         if self.ds_min > self.ds or self.ds > self.ds_max:
             raise SystemDefinitionError(f"need ds_min <= ds <= ds_max, got {self.ds_min}, {self.ds}, {self.ds_max}")
 
@@ -100,6 +114,12 @@ def _scaled(r, x):
     return float(np.max(np.abs(r) / np.maximum(np.abs(x), 0.1 * np.max(np.abs(x)) + 1e-300)))
 
 
+def _trivial_error(fl) -> float:
+    """|lambda_trivial - 1| / max(1, |lambda_2|) of a flow's monodromy matrix."""
+    lam, err = floquet(fl.Phi, fl.f)
+    return err / max(1.0, float(np.abs(lam[1])) if len(lam) > 1 else 1.0)
+
+
 def _nontrivial_near(lam, target):
     rest = lam[1:]
     k = int(np.argmin(np.abs(rest - target)))
@@ -109,13 +129,16 @@ def _nontrivial_near(lam, target):
 def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: PeriodicOrbit, mu0: float,
                    mu_end: float, *, param: str = "mu", section: int = 0,
                    options: ContinuationOptions | None = None, shooting: ShootingOptions | None = None,
-                   stop_at_mu: float | None = None, max_turns: int = 1) -> Branch:
+                   stop_at_mu: float | None = None, max_turns: int = 1,
+                   amplitude: Callable[[PiecewiseSystem, np.ndarray, float, Flow], float] | None = None) -> Branch:
     """Follow the branch through ``orbit`` (at parameter mu0) towards mu_end.
 
     system_at(mu) returns the system at parameter mu (its compiled functions are shared, only the
     parameters change). The run stops when mu leaves [min(mu0, mu_end), max(mu0, mu_end)],
     after ``max_turns`` folds once mu passes ``stop_at_mu`` (if given) on the way back, at
-    max_points, or when the step falls below ds_min."""
+    max_points, or when the step falls below ds_min. ``amplitude(system, x0, T, flow)`` gives
+    each point's amplitude from its converged flow (default: max |x1| of a simulation sampled
+    at 4001 points and at the events, :func:`orbit_amplitude`)."""
     opt = options or ContinuationOptions()
     sopt = shooting or ShootingOptions()
     n = len(orbit.x0)
@@ -128,13 +151,15 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     rtol_res = min(sopt.rtol, 1e-2 * opt.newton_tol)
     kw_res = dict(method=sopt.method, rtol=rtol_res, atol=rtol_res * sopt.atol / sopt.rtol,
                   max_events=sopt.max_events, max_steps=sopt.max_steps)
-    # three accuracies: residual flows (no sensitivities) at rtol_res; the converged
-    # points' Jacobians (multipliers, tangent) at 100 rtol, which gives x as accurately because
-    # the error control then covers Phi too (measured on the chapter-8 cycles); the Jacobians
-    # recomputed inside the corrector only steer it, at jacobian_rtol
-    kw_point = dict(kw_res, rtol=100 * kw_res["rtol"], atol=100 * kw_res["atol"])
-    rtol_j = max(opt.jacobian_rtol, kw_point["rtol"])
-    kw = dict(kw_res, rtol=rtol_j, atol=rtol_j * kw_res["atol"] / kw_res["rtol"])
+    # two accuracies: residual flows (no sensitivities) at rtol_res; flows with sensitivities
+    # (the corrector's Jacobians, the points' multipliers and tangents) at 100 rtol_res, which
+    # gives x as accurately because the error control then covers Phi too (measured on the
+    # chapter-8 cycles: 8.8e-11 against 8.5e-11), so their residuals count as well
+    kw_jac = dict(kw_res, rtol=100 * kw_res["rtol"], atol=100 * kw_res["atol"],
+                  method=opt.jacobian_method or sopt.method)
+
+    # the trivial multiplier of an orbit closed to newton_tol is not closer to 1 than ~1e3 times that
+    triv_tol = max(opt.trivial_tol, 1e3 * opt.newton_tol)
 
     def unpack(v):
         u = v * scale
@@ -149,16 +174,17 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         h = opt.dmu * max(abs(mu), 1e-3)
         return (system_at(mu + h).params - system_at(mu - h).params) / (2 * h)
 
-    def residual_and_jac(v, need_jac=True, precise=False):
+    def residual_and_jac(v, need_jac=True, method=None):
         """(r, J, flow) at v; J = [Phi - I without the section column | f | d phi / d mu],
-        the last column from the flow's parameter-sensitivity column; ``precise`` integrates
-        it at 100 times the orbits' rtol instead of jacobian_rtol."""
+        the last column from the flow's parameter-sensitivity column (``method``: instead of
+        jacobian_method)."""
         x, T, mu = unpack(v)
         if not (np.isfinite(T) and T > 0 and np.all(np.isfinite(x)) and np.isfinite(mu)):
             return None                  # a diverging corrector: the caller halves the step
         sys_ = system_at(mu)
         if need_jac:
-            fl = flow(sys_, x, T, param_direction=param_direction(mu), **(kw_point if precise else kw))
+            fl = flow(sys_, x, T, param_direction=param_direction(mu), **(kw_jac if method is None
+                                                                          else dict(kw_jac, method=method)))
         else:
             fl = flow(sys_, x, T, sensitivity=False, **kw_res)
         if not fl.ok:
@@ -177,13 +203,19 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         return t / np.linalg.norm(t)
 
     def iterate(v_pred, t, J0, newton):
-        """The corrector's iterations from v_pred: quasi-Newton from J0 (``newton`` False) or
-        Newton with J recomputed at every iterate. Returns (v, Jacobian evaluations) or None."""
+        """The corrector's iterations from v_pred, each from a flow without sensitivities.
+        Quasi-Newton (``newton`` False) from J0 with Broyden updates; a precise Jacobian flow
+        at the first iterate whose scaled residual is at most ``jacobian_reuse`` (it becomes
+        the Newton matrix and, at convergence, the point's Jacobian), and wherever the
+        residual contracts slower than chord_rate. Newton (``newton`` True): a Jacobian flow
+        at every iterate. Returns (v, Jacobian recomputations, (residual, J, flow) of the last
+        Jacobian flow or None) or None."""
         v = v_pred.copy()
         Jq = J0
         res_prev = np.inf
         r_prev = dv = None
         refreshes = 0
+        last_jac = None
         for k in range(opt.newton_max):
             out = residual_and_jac(v, need_jac=False)
             if out is None:
@@ -192,15 +224,18 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             res = _scaled(r, unpack(v)[0])
             g = np.dot(t, v - v_pred)
             if res < opt.newton_tol and abs(g) < 1e-12:
-                return v, refreshes
-            if newton or Jq is None or res > opt.chord_rate * res_prev:
-                if refreshes and res > res_prev:
-                    return None                  # diverging even with a fresh Jacobian
-                out = residual_and_jac(v, precise=newton)
+                return v, refreshes, last_jac
+            slow = res > opt.chord_rate * res_prev
+            if slow and res > res_prev and (newton or refreshes):
+                return None                      # diverging even with a fresh Jacobian
+            planned = last_jac is None and res <= opt.jacobian_reuse
+            if newton or Jq is None or slow or planned:
+                out = residual_and_jac(v)
                 if out is None:
                     return None
                 Jq = out[1]
-                refreshes += 1
+                last_jac = (v.copy(), out[1], out[2])
+                refreshes += not planned
             elif dv is not None:
                 # Broyden's rank-one update with the secant (dv, r - r_prev)
                 Jq = Jq + np.outer(r - r_prev - Jq @ dv, dv) / np.dot(dv, dv)
@@ -213,30 +248,41 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             # the residual of a strongly unstable orbit has a noise floor (integration error
             # amplified by its multiplier): a negligible Newton step also means convergence
             if np.linalg.norm(dv) < opt.step_tol and res < 1e3 * opt.newton_tol:
-                return v, refreshes
+                return v, refreshes, last_jac
         out = residual_and_jac(v, need_jac=False)
         if out is None or _scaled(out[0], unpack(v)[0]) >= 10 * opt.newton_tol:
             return None
-        return v, refreshes
+        return v, refreshes, last_jac
 
-    def correct(v_pred, t, J0):
+    def correct(v_pred, t, J0, reuse=True):
         """Converge from the predictor onto the branch: quasi-Newton from J0 (the last point's
-        Jacobian) with Broyden updates, so an iteration costs one flow without sensitivities;
-        J is recomputed at the iterate when the residual contracts slower than ``chord_rate``.
-        Where that fails (sharp folds), Newton with a precise J at every iterate. The
-        converged point gets its own precise J: its monodromy matrix gives the
-        multipliers, its null vector the tangent whose parameter component locates folds.
-        Returns (v, J, flow, Jacobian evaluations) or None."""
+        Jacobian extrapolated). Where that fails (sharp folds), Newton with a Jacobian flow
+        at every iterate. The converged point keeps the corrector's last Jacobian when that
+        was taken within ``jacobian_reuse`` of it (max-norm, scaled units) and ``reuse``;
+        else it gets its own (its monodromy matrix gives the multipliers, its null vector
+        the tangent whose parameter component locates folds).
+        Returns (v, J, flow, Jacobian recomputations) or None."""
         it = iterate(v_pred, t, J0, newton=False)
         if it is None:
             it = iterate(v_pred, t, None, newton=True)
             if it is None:
                 return None
-        v, refreshes = it
-        out = residual_and_jac(v, precise=True)
-        if out is None:
-            return None
-        return v, out[1], out[2], refreshes
+        v, refreshes, last_jac = it
+        if reuse and last_jac is not None and np.max(np.abs(v - last_jac[0])) <= opt.jacobian_reuse:
+            J, fl = last_jac[1], last_jac[2]
+        else:
+            out = residual_and_jac(v)
+            if out is None:
+                return None
+            J, fl = out[1], out[2]
+        if _trivial_error(fl) > triv_tol and (last_jac is not None or kw_jac["method"] != sopt.method):
+            # near a fold two multipliers meet at 1 and their errors grow like the square root
+            # of the monodromy matrix's: the point's own Jacobian, with Phi under error control
+            out = residual_and_jac(v, method=sopt.method)
+            if out is None:
+                return None
+            J, fl = out[1], out[2]
+        return v, J, fl, refreshes
 
     v = np.concatenate([orbit.x0[free], [orbit.period, mu0]]) / scale
     out = residual_and_jac(v)
@@ -295,7 +341,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         grow = min((1.4, 1.0, 0.7)[min(refreshes, 2)], 0.5 * opt.max_angle / max(turn, 1e-12))
         # fold: the parameter component of the tangent changes sign
         if np.sign(t_new[-1]) != np.sign(t[-1]):
-            sp = _refine_fold(lambda vp, tp: correct(vp, tp, J), tangent, unpack, v, t, ds, opt, len(pts_v) - 1)
+            sp = _refine_fold(lambda vp, tp: correct(vp, tp, J, reuse=False), tangent, unpack, v, t, ds, opt, len(pts_v) - 1)
             special.append(sp)
             turns += 1
         if tuple(fl_new.modes) != tuple(fl.modes) and len(fl_new.modes) != len(fl.modes):
@@ -323,7 +369,8 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         lams.append(lam)
         stab.append(bool(np.all(np.abs(lam[1:]) < 1.0)))
         modes.append(tuple(int(m) for m in ff.modes))
-        amps.append(orbit_amplitude(system_at(mu), x, T, method=sopt.method))
+        amps.append(amplitude(system_at(mu), x, T, ff) if amplitude is not None
+                    else orbit_amplitude(system_at(mu), x, T, method=sopt.method))
     lams = np.array(lams)
     # multiplier crossings: changes in the number of non-trivial multipliers outside the unit
     # circle through +1 (fold), through -1 (period doubling) or as a complex pair (torus)

@@ -28,6 +28,7 @@ class Flow:
     guards: np.ndarray
     status: Status
     dx_dmu: np.ndarray | None = None
+    event_states: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:
@@ -91,7 +92,7 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
     Phim = yf[n:].reshape(n, m) if sensitivity else np.full((n, m), np.nan)
     modes = np.concatenate([[ev_f[0]] if nev else [mode], ev_to[:nev]])
     return Flow(x, Phim[:, :n].copy(), mode, f, ev_t[:nev].copy(), modes, ev_g[:nev].copy(), st,
-                Phim[:, n].copy() if m > n else None)
+                Phim[:, n].copy() if m > n else None, ev_xb[:nev].copy())
 
 
 def fd_jacobian(system, x0, T, *, mode0=None, rel: float = 1e-6, **kw) -> np.ndarray:

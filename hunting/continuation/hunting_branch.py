@@ -1,9 +1,12 @@
 """Start and follow the hunting branch of a servo preset in one parameter."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import ConvergenceError, SystemDefinitionError
+from ..models import servo as S
 from ..models.presets import PRESETS, preset
 from .branch import Branch, ContinuationOptions, continue_orbit
 from .shooting import PeriodicOrbit, ShootingOptions, cycle_guess, guess_from_stick_error, shoot
@@ -14,6 +17,16 @@ def _stick_twin(name: str, overrides: dict):
     ov = dict(overrides)
     ov["model"] = "switch"
     return preset(name, **ov)
+
+
+def servo_amplitude(system, x0, T, fl) -> float:
+    """max |x1| over a servo loop's orbit from its flow: x1' = x2 and x2 = 0 is an event of the
+    exact Switch and LuGre loops (reversal, stick entry, the LuGre kink), so the extremes of
+    x1 are among the event states and the ends (not for the banded Switch: no event at 0)."""
+    a = max(abs(x0[0]), abs(fl.x[0]))
+    if fl.event_states is not None and len(fl.event_states):
+        a = max(a, float(np.max(np.abs(fl.event_states[:, 0]))))
+    return float(a)
 
 
 def find_cycle(name: str, overrides: dict | None = None, *, which: str = "stable", d_max: float = 0.05,
@@ -57,11 +70,16 @@ def follow(name: str, param: str, start: float, end: float, *, overrides: dict |
         raise SystemDefinitionError(f"preset = {name!r} is not known: presets are {sorted(PRESETS)}")
     overrides = dict(overrides or {})
     po = orbit if orbit is not None else find_cycle(name, {**overrides, param: start}, shooting=shooting)
-    base = preset(name, **{**overrides, param: start}).system
+    loop = preset(name, **{**overrides, param: start})
+    base = loop.system
+    opt = options or ContinuationOptions()
+    if opt.jacobian_method is None and loop.model_code == S.MODEL_LUGRE:
+        opt = replace(opt, jacobian_method="radau")       # the stiff loop's sensitivities: implicit
 
     def system_at(mu):
-        return base.with_param_array(preset(name, **{**overrides, param: mu}).system.params)
-    br = continue_orbit(system_at, po, start, end, param=param, options=options, shooting=shooting,
-                        stop_at_mu=start if stop_at is None else stop_at)
+        return base.with_param_array(preset(name, **{**overrides, param: mu}).param_array())
+    br = continue_orbit(system_at, po, start, end, param=param, options=opt, shooting=shooting,
+                        stop_at_mu=start if stop_at is None else stop_at,
+                        amplitude=None if loop.model_code == S.MODEL_BANDED else servo_amplitude)
     return Branch(br.param, br.mu, br.period, br.amplitude, br.multipliers, br.stable, br.x0, br.modes,
                   br.special, br.status, br.message, label=f"{name} {overrides}" if overrides else name)

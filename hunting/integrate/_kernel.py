@@ -530,19 +530,14 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                     numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
                     nfev += n
             else:
-                # Newton matrix of the augmented system, dropping d(J Phi)/dx: J_x for the state
-                # and J_x kron I for row-major Phi (d Phi[i, j]/dt = sum_k J[i, k] Phi[k, j])
+                # the state's Newton matrix only (radau_step_sensitivities solves the variational
+                # stages with the stage Jacobians)
                 for i in range(nb):
                     xw[i] = x[i]
                 nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, Jb, fbm, fbp, nb)
-                for i in range(n):
-                    for j in range(n):
-                        J[i, j] = 0.0
                 for i in range(nb):
                     for k in range(nb):
                         J[i, k] = Jb[i, k]
-                        for j in range(m_sens):
-                            J[nb + i * m_sens + j, nb + k * m_sens + j] = Jb[i, k]
             njac += 1
             en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
                                       Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
