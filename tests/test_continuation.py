@@ -166,3 +166,29 @@ def test_unstable_cycle_of_a_piecewise_linear_relay_oscillator():
     assert po.amplitude == pytest.approx(a, rel=1e-6)
     assert po.trivial_error < 1e-8
     assert abs(po.multipliers[1]) == pytest.approx(math.exp(2 * k), rel=1e-8)
+
+
+@pytest.mark.parametrize("name", ["table8.1-lugre", "table8.1-switch"])
+def test_branch_amplitudes_from_event_states_match_a_sampled_simulation(name):
+    """follow() takes each point's amplitude from its flow's event states (x2 = 0 is an event of
+    the exact loops); orbit_amplitude samples a fresh simulation at 4001 points plus events."""
+    from hunting.continuation import follow, orbit_amplitude
+    br = follow(name, "K", 0.3, 0.32)
+    assert len(br.mu) >= 2
+    for mu, x0, T, a in zip(br.mu, br.x0, br.period, br.amplitude):
+        ref = orbit_amplitude(preset(name, K=mu).system, x0, T)
+        assert a == pytest.approx(ref, rel=2e-6)         # the flows run at rtol 1e-9 and 1e-10
+
+
+def test_radau_jacobians_agree_with_dop853_along_a_lugre_branch():
+    """The LuGre branch's Jacobian flows by Radau (variational stages solved with the stage
+    Jacobians, state-only error control) against the same branch with DOP853 (Phi under error
+    control): same points, multipliers within 1e-5 away from the fold."""
+    from hunting.continuation import follow
+    a = follow("table8.1-lugre", "K", 0.3, 0.33)
+    b = follow("table8.1-lugre", "K", 0.3, 0.33, options=ContinuationOptions(jacobian_method="dop853"))
+    n = min(len(a.mu), len(b.mu))
+    assert n >= 2 and np.allclose(a.mu[:n], b.mu[:n], rtol=1e-6)
+    assert np.allclose(np.abs(a.multipliers[:n, 1]), np.abs(b.multipliers[:n, 1]), rtol=1e-5)
+    with pytest.raises(ValueError, match="jacobian_method"):
+        ContinuationOptions(jacobian_method="euler")
