@@ -5,8 +5,9 @@ start. Predictor: the unit tangent (null vector of [F_z | F_mu], oriented along 
 one) with a quadratic term through the point before. Corrector: quasi-Newton on
 [F(u); t . (u - u_pred)] = 0 from the Jacobian extrapolated along the branch, Broyden updates
 and one flow without sensitivities per iteration; the Jacobian (monodromy-based F_z, F_mu from
-the flow's parameter-sensitivity column) is recomputed only when the residual stops
-contracting, and full Newton takes over where the quasi-Newton fails. Step size grows after
+the flow's parameter-sensitivity column) is taken once the residual is small, where it stops
+contracting, and at the converged point unless the corrector's last one was close enough; full
+Newton takes over where the quasi-Newton fails. Step size grows after
 easy corrections and shrinks after hard or failed ones and sharp turns of the tangent. At
 every point: Floquet multipliers and stability. Special points: folds (mu
 turns back; a multiplier passes +1) located by bisection in arclength, period doublings
@@ -41,14 +42,15 @@ class ContinuationOptions:
     (max-norm, scaled units) of the iterate of the corrector's last Jacobian flow keeps that
     Jacobian for its multipliers and tangent (else it gets a flow of its own; with 1e-6 the
     multipliers on the chapter-8 LuGre branch stay within 4e-4 of flows at rtol 1e-11, as
-    without reuse: near the fold they are that sensitive); jacobian_method : integration method of the flows with
-    sensitivities (None: the shooting method; "radau" for stiff loops such as LuGre: its
-    variational stages are solved exactly with the stage Jacobians, at about half the cost of
-    DOP853 there); trivial_tol : a point whose trivial multiplier is further than this (or
-    1e3 newton_tol) from 1, relative to max(1, |lambda_2|), gets its Jacobian again, at the
-    point, with the shooting method and Phi under its error control (near a fold two
-    multipliers meet at 1 and their errors grow like the square root of Phi's). Flows without sensitivities run at rtol = min(shooting rtol,
-    newton_tol / 100), flows with sensitivities at 100 times that."""
+    without reuse: near the fold they are that sensitive); jacobian_method : integration
+    method of the flows with sensitivities (None: the shooting method; "radau" for stiff
+    loops such as LuGre: its variational stages are solved exactly with the stage Jacobians,
+    5-10 ms a chapter-8 cycle against DOP853's 9-13 ms); trivial_tol : a point whose trivial
+    multiplier is further than this (or 1e3 newton_tol) from 1, relative to
+    max(1, |lambda_2|), gets its Jacobian again, at the point, with the shooting method and
+    Phi under its error control (near a fold two multipliers meet at 1 and their errors grow
+    like the square root of Phi's). Flows without sensitivities run at rtol =
+    min(shooting rtol, newton_tol / 100), flows with sensitivities at 100 times that."""
 
     ds: float = 0.05
     ds_min: float = 1e-6
@@ -152,9 +154,8 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     kw_res = dict(method=sopt.method, rtol=rtol_res, atol=rtol_res * sopt.atol / sopt.rtol,
                   max_events=sopt.max_events, max_steps=sopt.max_steps)
     # two accuracies: residual flows (no sensitivities) at rtol_res; flows with sensitivities
-    # (the corrector's Jacobians, the points' multipliers and tangents) at 100 rtol_res, which
-    # gives x as accurately because the error control then covers Phi too (measured on the
-    # chapter-8 cycles: 8.8e-11 against 8.5e-11), so their residuals count as well
+    # (the corrector's Jacobians, the points' multipliers and tangents) at 100 rtol_res: they
+    # only steer the corrector and give the multipliers, every residual is a flow of its own
     kw_jac = dict(kw_res, rtol=100 * kw_res["rtol"], atol=100 * kw_res["atol"],
                   method=opt.jacobian_method or sopt.method)
 
@@ -208,7 +209,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         at the first iterate whose scaled residual is at most ``jacobian_reuse`` (it becomes
         the Newton matrix and, at convergence, the point's Jacobian), and wherever the
         residual contracts slower than chord_rate. Newton (``newton`` True): a Jacobian flow
-        at every iterate. Returns (v, Jacobian recomputations, (residual, J, flow) of the last
+        at every iterate. Returns (v, Jacobian recomputations, (iterate, J, flow) of the last
         Jacobian flow or None) or None."""
         v = v_pred.copy()
         Jq = J0
@@ -268,14 +269,15 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             if it is None:
                 return None
         v, refreshes, last_jac = it
-        if reuse and last_jac is not None and np.max(np.abs(v - last_jac[0])) <= opt.jacobian_reuse:
+        reused = reuse and last_jac is not None and np.max(np.abs(v - last_jac[0])) <= opt.jacobian_reuse
+        if reused:
             J, fl = last_jac[1], last_jac[2]
         else:
             out = residual_and_jac(v)
             if out is None:
                 return None
             J, fl = out[1], out[2]
-        if _trivial_error(fl) > triv_tol and (last_jac is not None or kw_jac["method"] != sopt.method):
+        if _trivial_error(fl) > triv_tol and (reused or kw_jac["method"] != sopt.method):
             # near a fold two multipliers meet at 1 and their errors grow like the square root
             # of the monodromy matrix's: the point's own Jacobian, with Phi under error control
             out = residual_and_jac(v, method=sopt.method)

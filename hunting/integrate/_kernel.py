@@ -312,7 +312,7 @@ KERNEL_SIG = types.void(
 @numba.njit(cache=True)
 def workspace_sizes(n, nb, ng, n_modes, zeno_count):
     """Sizes (float, int) of the workspaces integrate_kernel needs (callable from Python and numba)."""
-    nf = 40 * n + 11 * n * n + 11 * nb + 4 * nb * nb + 3 * ng + max(zeno_count, 1) + n_modes
+    nf = 40 * n + 11 * n * n + 11 * nb + 3 * nb * nb + 3 * ng + max(zeno_count, 1) + n_modes
     return nf, 4 * n + ng
 
 
@@ -335,7 +335,8 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
     index, ``info[I_NEVTOT]`` the events so far (both carried across resumes).
 
     ``nb < x0.size`` integrates sensitivities: x0 = [x (nb), Phi0 row-major (nb * m)], the
-    variational equations ride along (part of the error control) and every event multiplies Phi
+    variational equations ride along (part of the explicit methods' error control; Radau
+    differentiates its collocation solution exactly and controls x only) and every event multiplies Phi
     by its saltation matrix. Guards, transitions and mode_of always see the base state only.
     With m = nb + 1 the last column is the sensitivity to a parameter mu along the direction
     dpw[0] = dp/dmu (dpw (2, len(p)), row 1 scratch): psi' = J psi + f_mu, and at events
@@ -423,8 +424,6 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
     xw2 = wf[o:o + nb]
     o += nb
     Jw = wf[o:o + nb * nb].reshape((nb, nb))
-    o += nb * nb
-    Jb = wf[o:o + nb * nb].reshape((nb, nb))
     o += nb * nb
     Ssal = wf[o:o + nb * nb].reshape((nb, nb))
     o += nb * nb
@@ -530,14 +529,11 @@ def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                     numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
                     nfev += n
             else:
-                # the state's Newton matrix only (radau_step_sensitivities solves the variational
-                # stages with the stage Jacobians)
+                # J_x into J's leading block: radau_step solves the variational stages with the
+                # stage Jacobians itself
                 for i in range(nb):
                     xw[i] = x[i]
-                nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, Jb, fbm, fbp, nb)
-                for i in range(nb):
-                    for k in range(nb):
-                        J[i, k] = Jb[i, k]
+                nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, J, fbm, fbp, nb)
             njac += 1
             en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
                                       Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)

@@ -11,7 +11,7 @@ import numba
 import numpy as np
 
 EPS = np.finfo(np.float64).eps
-CBRT_EPS = float(np.cbrt(EPS))    # central-difference step factor (a constant: cbrt is slow)
+CBRT_EPS = float(np.cbrt(EPS))    # central-difference step factor, not recomputed per call (~5 % of a step)
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
@@ -57,18 +57,15 @@ def param_derivative(vf, mode, t, x, p, dpw, out, fm):
     """out = d f / d mu at x by central differences along dpw[0] (p is perturbed in place and
     restored from dpw[1]; fm is scratch). Returns the f evaluations."""
     h = param_step(p, dpw)
-    for k in range(p.size):            # only the entries mu moves (writing all of p cost
-        if dpw[0, k] != 0.0:           # ~25 % of a sensitivity step)
-            dpw[1, k] = p[k]
-            p[k] = dpw[1, k] + h * dpw[0, k]
+    for k in range(p.size):
+        dpw[1, k] = p[k]
+        p[k] = dpw[1, k] + h * dpw[0, k]
     vf(mode, t, x, p, out)
     for k in range(p.size):
-        if dpw[0, k] != 0.0:
-            p[k] = dpw[1, k] - h * dpw[0, k]
+        p[k] = dpw[1, k] - h * dpw[0, k]
     vf(mode, t, x, p, fm)
     for k in range(p.size):
-        if dpw[0, k] != 0.0:
-            p[k] = dpw[1, k]
+        p[k] = dpw[1, k]
     for i in range(x.size):
         out[i] = (out[i] - fm[i]) / (2.0 * h)
     return 2

@@ -210,122 +210,21 @@ def numerical_jacobian(vf, mode, t, y, f, p, rtol, atol, J, ytmp, ftmp):
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
 def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
                R, ytmp, y_new, f_new, err):
-    """One Radau IIA (order 5) step with simplified Newton on the full 3n stage system.
+    """One Radau IIA (order 5) step of y = [x (nb), Phi row-major (nb, mc)] (mc = 0: no
+    sensitivities, nb = n).
 
-    ``J`` (n, n) must hold the Jacobian of the right-hand side at (t, y) (for an augmented state
-    only its leading (nb, nb) block is read: J_x). Returns (error norm, converged, f evals);
-    when Newton does not converge the caller shrinks h. Writes Z (3, n) stage increments,
-    y_new, f_new. An augmented state (nb < n) goes to :func:`radau_step_sensitivities`."""
-    n = y.size
-    if nb < n:
-        return radau_step_sensitivities(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol,
-                                        J, M, piv, Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
-    m = 3 * n
-    # iteration matrix M = I - h (A kron J)
-    for a in range(3):
-        for b in range(3):
-            hab = h * RADAU_A[a, b]
-            for i in range(n):
-                for j in range(n):
-                    M[a * n + i, b * n + j] = -hab * J[i, j]
-    for k in range(m):
-        M[k, k] += 1.0
-    if not lu_factor(M, piv):
-        return np.inf, False, 0
-    tol = max(10.0 * EPS / rtol, min(0.03, rtol ** 0.5))
-    for a in range(3):
-        for i in range(n):
-            Z[a, i] = 0.0
-    nfev = 0
-    converged = False
-    dz_old = -1.0
-    rate = -1.0
-    for it in range(NEWTON_MAXITER):
-        for a in range(3):
-            for i in range(n):
-                ytmp[i] = y[i] + Z[a, i]
-            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + RADAU_C[a] * h, ytmp, p, F3[a])
-        nfev += 3
-        finite = True
-        for a in range(3):
-            for i in range(n):
-                if not np.isfinite(F3[a, i]):
-                    finite = False
-        if not finite:
-            return np.inf, False, nfev
-        for a in range(3):
-            for i in range(n):
-                acc = 0.0
-                for b in range(3):
-                    acc += RADAU_A[a, b] * F3[b, i]
-                R[a * n + i] = -Z[a, i] + h * acc
-        lu_solve(M, piv, R)
-        s = 0.0
-        for a in range(3):
-            for i in range(n):
-                Z[a, i] += R[a * n + i]
-                sc = atol + abs(y[i]) * rtol
-                s += (R[a * n + i] / sc) ** 2
-        dz = np.sqrt(s / m)
-        if dz_old >= 0.0:
-            rate = dz / dz_old if dz_old > 0 else 0.0
-        if rate >= 0.0 and (rate >= 1.0 or rate ** (NEWTON_MAXITER - it) / (1.0 - rate) * dz > tol):
-            break
-        if dz == 0.0 or (rate >= 0.0 and rate / (1.0 - rate) * dz < tol):
-            converged = True
-            break
-        dz_old = dz
-    if not converged:
-        return np.inf, False, nfev
-    for i in range(n):
-        y_new[i] = y[i] + Z[2, i]
-    # error estimate: (mu/h I - J)^-1 (f + Z^T E / h)
-    for i in range(n):
-        for j in range(n):
-            Mr[i, j] = -J[i, j]
-        Mr[i, i] += RADAU_MU_REAL / h
-    if not lu_factor(Mr, pivr):
-        return np.inf, False, nfev
-    for i in range(n):
-        acc = 0.0
-        for a in range(3):
-            acc += Z[a, i] * RADAU_E[a]
-        err[i] = f[i] + acc / h
-    lu_solve(Mr, pivr, err)
-    en = _rms_scaled(err, y, y_new, rtol, atol)
-    if en > 1.0:
-        # Hairer's refinement of the estimate for stiff components (one more f evaluation)
-        for i in range(n):
-            ytmp[i] = y[i] + err[i]
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, ytmp, p, f_new)
-        nfev += 1
-        for i in range(n):
-            acc = 0.0
-            for a in range(3):
-                acc += Z[a, i] * RADAU_E[a]
-            err[i] = f_new[i] + acc / h
-        lu_solve(Mr, pivr, err)
-        en = _rms_scaled(err, y, y_new, rtol, atol)
-    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new)
-    nfev += 1
-    return en, True, nfev
-
-
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
-def radau_step_sensitivities(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, J, M, piv,
-                             Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err):
-    """One Radau IIA step of an augmented state y = [x (nb), Phi row-major (nb, mc)].
-
-    Simplified Newton on the 3 nb state stages only (J[:nb, :nb] = J_x at (t, x)). The
-    variational stages are linear in Phi and are solved exactly with the Jacobians at the
-    converged stage states Y_b: (I - h {A_ab J_x(Y_b)}) W = h (A kron I) [J_x(Y_b) Phi0 + f_mu(Y_b)],
-    one LU of 3 nb x 3 nb for all mc columns (a dense Newton matrix of the 3 n augmented
-    system would cost (3 n)^3 per step: 72^3 for the LuGre loop). Phi_new is then the exact
-    derivative of the step's collocation solution (internal numerical differentiation), so
-    the error control covers the state only, as CVODES does by default: with Phi in it the
-    steps were 3.7 times as many on the chapter-8 LuGre cycles, while Phi's error follows the
-    state's (Phi within 1e-6, x within 2e-7 at rtol 1e-8, against rtol 1e-12).
-    Returns (error norm, converged, f evals)."""
+    Simplified Newton on the 3 nb state stages (``J`` (n, n): its leading (nb, nb) block holds
+    J_x at (t, x)). With sensitivities, the variational stages are linear in Phi and are solved
+    exactly with the Jacobians at the converged stage states Y_b:
+    (I - h {A_ab J_x(Y_b)}) W = h (A kron I) [J_x(Y_b) Phi0 + f_mu(Y_b)], one LU of 3 nb x 3 nb
+    for all mc columns (a dense Newton matrix of the 3 n augmented system would cost (3 n)^3 per
+    step: 72^3 for the LuGre loop). Phi_new is then the exact derivative of the step's
+    collocation solution (internal numerical differentiation), so the error control covers the
+    state only, as CVODES does by default: with Phi in it the steps were 3.7 times as many on
+    the chapter-8 LuGre cycles, while Phi's error follows the state's (at rtol 1e-8, Phi within
+    3.1e-6 and x within 3e-7 of rtol 1e-12 at K = 0.05, 0.3, 0.6).
+    Returns (error norm, converged, f evals); when Newton does not converge the caller shrinks
+    h. Writes Z (3, n) stage increments, y_new, f_new."""
     n = y.size
     mc = (n - nb) // nb
     k3 = 3 * nb
@@ -385,42 +284,43 @@ def radau_step_sensitivities(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode
         dz_old = dz
     if not converged:
         return np.inf, False, nfev
-    # variational stages: F3[b, nb:] = J_x(Y_b) Phi0 (+ f_mu(Y_b) in the parameter column)
-    for b in range(3):
-        tb = t + RADAU_C[b] * h
-        for i in range(nb):
-            yw[i] = y[i] + Z[b, i]
-        nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, tb, yw, p, Jw, fp, fm, nb)
-        for a in range(3):
-            hab = h * RADAU_A[a, b]
+    if mc > 0:
+        # variational stages: F3[b, nb:] = J_x(Y_b) Phi0 (+ f_mu(Y_b) in the parameter column)
+        for b in range(3):
+            tb = t + RADAU_C[b] * h
             for i in range(nb):
-                for k in range(nb):
-                    Ms[a * nb + i, b * nb + k] = -hab * Jw[i, k]
-        for i in range(nb):
-            for j in range(mc):
-                acc = 0.0
-                for k in range(nb):
-                    acc += Jw[i, k] * y[nb + k * mc + j]
-                F3[b, nb + i * mc + j] = acc
-        if mc > nb:
-            nfev += param_derivative(vf, mode, tb, yw, p, dpw, fp, fm)
+                yw[i] = y[i] + Z[b, i]
+            nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, tb, yw, p, Jw, fp, fm, nb)
+            for a in range(3):
+                hab = h * RADAU_A[a, b]
+                for i in range(nb):
+                    for k in range(nb):
+                        Ms[a * nb + i, b * nb + k] = -hab * Jw[i, k]
             for i in range(nb):
-                F3[b, nb + i * mc + nb] += fp[i]
-    for k in range(k3):
-        Ms[k, k] += 1.0
-    if not lu_factor(Ms, piv):
-        return np.inf, False, nfev
-    for j in range(mc):
-        for a in range(3):
-            for i in range(nb):
-                acc = 0.0
-                for b in range(3):
-                    acc += RADAU_A[a, b] * F3[b, nb + i * mc + j]
-                Rs[a * nb + i] = h * acc
-        lu_solve(Ms, piv, Rs)
-        for a in range(3):
-            for i in range(nb):
-                Z[a, nb + i * mc + j] = Rs[a * nb + i]
+                for j in range(mc):
+                    acc = 0.0
+                    for k in range(nb):
+                        acc += Jw[i, k] * y[nb + k * mc + j]
+                    F3[b, nb + i * mc + j] = acc
+            if mc > nb:
+                nfev += param_derivative(vf, mode, tb, yw, p, dpw, fp, fm)
+                for i in range(nb):
+                    F3[b, nb + i * mc + nb] += fp[i]
+        for k in range(k3):
+            Ms[k, k] += 1.0
+        if not lu_factor(Ms, piv):
+            return np.inf, False, nfev
+        for j in range(mc):
+            for a in range(3):
+                for i in range(nb):
+                    acc = 0.0
+                    for b in range(3):
+                        acc += RADAU_A[a, b] * F3[b, nb + i * mc + j]
+                    Rs[a * nb + i] = h * acc
+            lu_solve(Ms, piv, Rs)
+            for a in range(3):
+                for i in range(nb):
+                    Z[a, nb + i * mc + j] = Rs[a * nb + i]
     for i in range(n):
         y_new[i] = y[i] + Z[2, i]
     # error estimate of the state: (mu/h I - J_x)^-1 (f + Z^T E / h)
