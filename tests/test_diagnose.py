@@ -129,6 +129,19 @@ def test_hidden_lag_is_found():
     assert dg.extended_model.lag == pytest.approx(c.parameters["lag"])
 
 
+def test_hidden_reversal_presliding_is_found():
+    """A LuGre contact (sigma0 = 1e5 N/m: the friction builds up over about 0.2 mm after each
+    reversal) diagnosed with Coulomb + viscous: `reversal` first, sigma0 within the grid's
+    resolution, and the whole level building up (scale near 1; measured 9.4e4 N/m, 0.89)."""
+    dg = _run(TruePlant(sigma0=1e5))
+    c = dg.causes[0]
+    assert c.name == "reversal"
+    assert c.parameters["sigma0"] == pytest.approx(1e5, rel=0.3)
+    assert 0.7 < c.parameters["scale"] < 1.2
+    assert dg.extended < 0.4 * dg.nominal
+    assert dg.extended_model.law == "lugre" and dg.extended_model.sigma0 == c.parameters["sigma0"]
+
+
 def test_hidden_dwell_is_found():
     """Break-away force growing by 10 N with the rest (time constant 1 s), slow strokes and rests
     of 10 ms .. 3 s: dwell first, its growth recovered, the break-away forces of the validation
@@ -286,3 +299,36 @@ def test_virtual_limms_switch_model_with_cogging_finds_presliding():
     b = dg.behaviour
     assert b["measured"]["at_rest"] and b["extended"]["at_rest"] and not b["nominal"]["at_rest"]
     assert b["extended"]["position_rms"] < 0.2 * b["nominal"]["position_rms"]
+
+
+def test_wrong_stribeck_level_is_found_and_the_event_map_follows(tmp_path):
+    """Table 9.1's hunting loop (P = 20) measured, diagnosed with Fs = 3 instead of 4: the force
+    channel must move the Stribeck level back (the nominal dip kept, not dropped), and the
+    extended model's re-simulated event map must match the measured one where the nominal's
+    does not (its hunting cycle is a third of the measured amplitude)."""
+    from hunting.diagnose.data import Measurement
+    from hunting.diagnose.report import write_report
+    from hunting.diagnose.resimulate import resimulate
+    true = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 20.0}})
+    nominal = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 20.0, "Fs": 3.0}})
+    dt, n = 1e-3, 40_000
+
+    def run(d0, seed):
+        t = np.arange(n) * dt
+        rest = Measurement(t, np.full(n, d0), np.zeros(n), q_ref=np.zeros(n))
+        sim = resimulate(rest, true, resolution=1e-5, force_noise=np.random.default_rng(seed).normal(0, 0.05, n))
+        return Measurement(t, sim.q, sim.u, q_ref=np.zeros(n))
+    dg = diagnose(run(0.5, 1), nominal, run(0.4, 2), causes=["offset", "stribeck", "presliding"])
+    assert [c.name for c in dg.causes] == ["stribeck"]
+    p, s = dg.causes[0].parameters, dg.causes[0].sigma
+    assert p["Fs"] == pytest.approx(4.0, abs=max(3 * s["Fs"], 0.01)) and p["Fc"] == pytest.approx(2.0, abs=0.01)
+    assert p["vs"] == pytest.approx(0.1, rel=0.2)
+    b = dg.behaviour
+    m = b["measured"]["map_contraction"]
+    assert abs(b["extended"]["map_contraction"] - m) < 0.01 < 0.1 < abs(b["nominal"]["map_contraction"] - m)
+    assert b["extended"]["cycle_amplitude"] == pytest.approx(b["measured"]["cycle_amplitude"], rel=0.02)
+    assert b["nominal"]["cycle_amplitude"] < 0.5 * b["measured"]["cycle_amplitude"]
+    html = write_report(dg, tmp_path)
+    assert (tmp_path / "event_map.png").is_file() and "event_map.png" in html.read_text()
+    saved = json.loads((tmp_path / "diagnosis.json").read_text())
+    assert len(saved["behaviour"]["measured"]["event_map"]) == len(b["measured"]["event_map"]) >= 20

@@ -6,10 +6,17 @@ where the position stays within ``counts`` encoder counts for at least ``window`
 moving more than ``moved`` from the previous stick). The hunting cycle is judged on the final
 stretch of constant reference (a regulator task): its amplitude (half the peak-to-peak error),
 its period (first autocorrelation maximum of the error) and whether the loop ended at rest (the
-position stays within ``rest_counts`` counts over the last fifth: the equilibrium set attracts)."""
+position stays within ``rest_counts`` counts over the last fifth: the equilibrium set attracts).
+
+The measured event map (thesis sections 9.4 and 10.4.3): d_n is the position error during the
+n-th stick phase (its mean over the phase), and the pairs (d_n, d_{n+1}) of consecutive stick
+phases under the same constant reference are points of the stick-to-stick map P; a sampled
+simulation's pairs approach the exact map of :mod:`hunting.eventmap` as the sample time goes to
+zero (tests). Its contraction |d_{n+1}| / |d_n| (median over the pairs) says at a glance what the
+map does: below 1 the sticks approach the setpoint, near 1 the loop hunts on a cycle."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -43,13 +50,43 @@ def stick_phases(y: np.ndarray, dt: float, resolution: float, *, window: float =
     return phases
 
 
+def stick_errors(q: np.ndarray, q_ref: np.ndarray, phases: list) -> tuple:
+    """(d, stretch): the position error d_n [m] of each stick phase (first, last index) of q (n,)
+    (mean of q - q_ref over the phase) and the index of the constant-reference stretch it lies in
+    (-1 when q_ref changes during the phase)."""
+    piece = np.concatenate([[0], np.cumsum(np.abs(np.diff(q_ref)) > 1e-12)])
+    d, stretch = [], []
+    for a, b in phases:
+        d.append(float(np.mean(q[a:b + 1] - q_ref[a:b + 1])))
+        stretch.append(int(piece[a]) if piece[a] == piece[b] else -1)
+    return np.array(d), np.array(stretch, dtype=np.int64)
+
+
+def event_map_points(d: np.ndarray, stretch: np.ndarray) -> np.ndarray:
+    """Points (d_n, d_{n+1}) of the measured event map (m, 2): consecutive stick phases under the
+    same constant reference."""
+    same = (stretch[:-1] == stretch[1:]) & (stretch[:-1] >= 0)
+    return np.column_stack([d[:-1][same], d[1:][same]]) if d.size > 1 else np.zeros((0, 2))
+
+
+def map_contraction(points: np.ndarray, resolution: float, counts: int = 2) -> float | None:
+    """Median of |d_{n+1}| / |d_n| over the event-map points with |d_n| above ``counts`` counts
+    (None without such points)."""
+    keep = np.abs(points[:, 0]) > counts * max(resolution, 1e-12)
+    if not keep.any():
+        return None
+    return float(np.median(np.abs(points[keep, 1]) / np.abs(points[keep, 0])))
+
+
 @dataclass(frozen=True)
 class Behaviour:
     """sticks : number of stick phases; stick_time [s] : their mean duration; stick_error [m] :
     RMS of the position error q - q_ref at the start of each stick; cycle_amplitude [m] and
     cycle_period [s] on the final constant-reference stretch (period None when at rest or not
     periodic); at_rest : the loop ends at rest there; final_error [m] : mean error over the
-    last fifth of it. None where the run has no such stretch."""
+    last fifth of it. None where the run has no such stretch. event_map : the measured event
+    map's points [[d_n, d_{n+1}], ...] [m]; map_contraction : median |d_{n+1}| / |d_n| (None
+    without points)."""
 
     sticks: int
     stick_time: float | None
@@ -58,6 +95,8 @@ class Behaviour:
     cycle_period: float | None
     at_rest: bool | None
     final_error: float | None
+    event_map: list = field(default_factory=list)
+    map_contraction: float | None = None
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -76,11 +115,14 @@ def behaviour(t: np.ndarray, q: np.ndarray, q_ref: np.ndarray, resolution: float
     dt = float(t[1] - t[0])
     e = q - q_ref
     ph = stick_phases(q, dt, resolution, **stick_kw)
+    d, stretch = stick_errors(q, q_ref, ph)
+    pts = event_map_points(d, stretch)
+    emap = dict(event_map=pts.tolist(), map_contraction=map_contraction(pts, resolution))
     stick_time = float(np.mean([(b - a + 1) * dt for a, b in ph])) if ph else None
     stick_error = float(np.sqrt(np.mean([e[a] ** 2 for a, _ in ph]))) if ph else None
     k0 = _final_stretch(q_ref, max(int(1.0 / dt), 20))
     if k0 is None:
-        return Behaviour(len(ph), stick_time, stick_error, None, None, None, None)
+        return Behaviour(len(ph), stick_time, stick_error, None, None, None, None, **emap)
     tail = e[k0 + (q.size - k0) // 2:]
     last = e[q.size - (q.size - k0) // 5:]
     at_rest = bool(np.ptp(last) <= rest_counts * max(resolution, 1e-9))
@@ -95,7 +137,7 @@ def behaviour(t: np.ndarray, q: np.ndarray, q_ref: np.ndarray, resolution: float
             j = int(neg[0] + np.argmax(ac[neg[0]:]))
             if ac[j] > 0.5 and j < x.size - 1:
                 period = j * dt
-    return Behaviour(len(ph), stick_time, stick_error, amp, period, at_rest, float(np.mean(last)))
+    return Behaviour(len(ph), stick_time, stick_error, amp, period, at_rest, float(np.mean(last)), **emap)
 
 
 def simulation_errors(meas, sim, cm: float) -> dict:

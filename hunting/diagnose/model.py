@@ -4,7 +4,7 @@ residual needs.
 
 Schema (keys beyond these are errors, so typos are caught):
 
-    {"preset": "table9.1", "set": {"P": 60.0}}
+    {"preset": "table9.1", "set": {"P": 60.0}}     # the preset's plant, friction, cogging and PID
     {"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 0.0, "delay": 0.0,
                "cogging": [{"pitch": 0.02, "cos": [..], "sin": [..]}, ...],      # harmonics k = 1, 2..
                "cogging_table": [{"q": [..], "F": [..]}, ...],                  # linear interpolation
@@ -239,9 +239,14 @@ class NominalModel:
             loop = preset(d["preset"], **d.get("set", {}))
             fr = loop.friction
             law = "lugre" if isinstance(fr, LuGre) else "switch"
+            # the preset's PID (continuous in the thesis: updated every data sample here, unless a
+            # 'controller' is given) and its cogging come along
+            c = loop.controller
+            ctrl = d.get("controller") or {"type": "pid", "kp": c.kp, "kd": c.kd, "ki": c.ki}
+            cog = () if loop.plant.cogging is None else (loop.plant.cogging,)
             return NominalModel(loop.plant.mass, loop.plant.motor_constant, fr.curve, law,
                                 sigma0=getattr(fr, "sigma0", None), sigma1=getattr(fr, "sigma1", None),
-                                controller=d.get("controller"), source=d, **sens)
+                                controller=ctrl, cogging=cog, source=d, **sens)
         for k in ("plant", "friction"):
             if k not in d:
                 raise SystemDefinitionError(f"model: missing {k!r} (or give a 'preset')")

@@ -66,8 +66,54 @@ def behaviour_figure(dg: Diagnosis, validate, path) -> None:
     save(fig, path)
 
 
+def event_map_figure(dg: Diagnosis, path) -> None:
+    """The measured event map of the validation run (stick error d_n against the next, d_{n+1},
+    under a constant reference) with the cobweb of its last stretch, beside the re-simulated
+    nominal and extended loops' maps; the diagonal (fixed points: one-sided cycles or rest) and
+    the anti-diagonal (symmetric two-stick cycles)."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.0, 6.6))
+    b = dg.behaviour
+    every = [np.asarray(b[k]["event_map"], float).reshape(-1, 2) for k in ("measured", "nominal", "extended")]
+    lim = max([float(np.max(np.abs(p))) for p in every if p.size] + [1e-12]) * 1.08
+    ax.plot([-lim, lim], [-lim, lim], "-", color="0.4", lw=0.8, label="diagonal")
+    ax.plot([-lim, lim], [lim, -lim], ":", color="0.4", lw=0.8, label="anti-diagonal")
+    meas = every[0]
+    if meas.shape[0]:
+        # cobweb through the measured sequence's last (at most 12) steps: the pairs chain (d_{n+1}
+        # of one is d_n of the next) as long as they are consecutive
+        chain = [meas[-1]]
+        for pt in meas[-2::-1]:
+            if pt[1] != chain[-1][0] or len(chain) == 12:
+                break
+            chain.append(pt)
+        xs = [c[0] for c in chain[::-1]] + [chain[0][1]]
+        px, py = [xs[0]], [xs[0]]
+        for a, c in zip(xs[:-1], xs[1:]):
+            px += [a, c]
+            py += [c, c]
+        ax.plot(px, py, "-", color="k", lw=0.6, alpha=0.6, label="cobweb (measured, last steps)")
+    for pts, style, lab in zip(every, ("ko", "C3x", "C0+"), ("measured", "nominal", "extended")):
+        c = b[lab]["map_contraction"]
+        note = "" if c is None else f", |d$_{{n+1}}$|/|d$_n$| = {c:.3g}"
+        ax.plot(pts[:, 0], pts[:, 1], style, ms=8 if lab == "measured" else 6, mfc="none" if lab == "measured" else None,
+                label=f"{lab} ({pts.shape[0]} pairs{note})")
+    ax.axhline(0, color="0.85", lw=0.6)
+    ax.axvline(0, color="0.85", lw=0.6)
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_xlabel("stick error d$_n$ [m]")
+    ax.set_ylabel("next stick error d$_{n+1}$ [m]")
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
+    ax.set_title("event map of the validation run: measured and re-simulated", fontsize=10)
+    fig.tight_layout()
+    save(fig, path)
+
+
 def write_report(dg: Diagnosis, directory) -> Path:
-    """JSON, the figures (force residual; behaviour when the view exists) and index.html in
+    """JSON, the figures (force residual; behaviour and event map when the view exists) and index.html in
     ``directory``; returns the HTML path."""
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
@@ -79,6 +125,9 @@ def write_report(dg: Diagnosis, directory) -> Path:
     if dg.behaviour is not None:
         behaviour_figure(dg, dg.validation, d / "behaviour.png")
         imgs.append("behaviour.png")
+        if any(dg.behaviour[k]["event_map"] for k in ("measured", "nominal", "extended")):
+            event_map_figure(dg, d / "event_map.png")
+            imgs.append("event_map.png")
     gains = "".join(f"<tr><td>{html.escape(g['metric'])}</td><td>{g['nominal']}</td><td>{g['extended']}</td></tr>"
                     for g in dg.gains())
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in dg.notes)

@@ -97,7 +97,8 @@ class Diagnosis:
     def gains(self) -> list:
         """Validation metrics of the nominal against the extended model: force residual RMS [N],
         and from the behaviour view position and drive-force RMS errors of the re-simulation,
-        stick-error, cycle-amplitude and cycle-period errors against the measurement."""
+        stick-error, cycle-amplitude, cycle-period and event-map-contraction errors against the
+        measurement."""
         out = []
         if self.nominal is not None:
             out.append(dict(metric="force residual RMS [N]", nominal=self.nominal, extended=self.extended))
@@ -107,7 +108,8 @@ class Diagnosis:
                                ("force_rms", "re-simulated drive force RMS error [N]")):
                 out.append(dict(metric=label, nominal=b["nominal"][key], extended=b["extended"][key]))
             for key, label in (("stick_error", "stick error RMS [m]"), ("cycle_amplitude", "cycle amplitude [m]"),
-                               ("cycle_period", "cycle period [s]"), ("final_error", "final error [m]")):
+                               ("cycle_period", "cycle period [s]"), ("final_error", "final error [m]"),
+                               ("map_contraction", "event map contraction |d_n+1| / |d_n|")):
                 m = b["measured"][key]
                 if m is None:
                     continue
@@ -141,10 +143,15 @@ def _n_eff(r: np.ndarray) -> float:
 
 
 def _designs(name, kin_f, kin_v, model, mf, mv):
-    """(Phi_fit, Phi_val, hyper) per hyper-parameter variant of a cause, on the used samples."""
+    """(Phi_fit, Phi_val, hyper, shift_fit, shift_val) per hyper-parameter variant of a cause, on
+    the used samples; shift is the known, unfitted part of the extension's force change (the
+    cause's optional ``shift``; zeros without one)."""
     mod = CAUSES[name]
+    shift = getattr(mod, "shift", None)
     for hyper in mod.hypers(kin_f, model):
-        yield mod.design(kin_f, model, hyper)[mf], mod.design(kin_v, model, hyper)[mv], hyper
+        sf = shift(kin_f, model, hyper)[mf] if shift else np.zeros(int(mf.sum()))
+        sv = shift(kin_v, model, hyper)[mv] if shift else np.zeros(int(mv.sum()))
+        yield mod.design(kin_f, model, hyper)[mf], mod.design(kin_v, model, hyper)[mv], hyper, sf, sv
 
 
 def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
@@ -186,6 +193,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     result, rejected = list(fc["causes"]), list(fc["rejected"])
     can_sim = model.controller is not None and validate.q_ref is not None and fit.q_ref is not None
     for name in stick_names:
+        if ext.law == "lugre" and model.law != "lugre":
+            rejected.append(dict(name=name, step="stick", statistic=None, p_value=None, validation_gain=None,
+                                 reason="the force channel's extension already has LuGre presliding (reversal)"))
+            continue
         cause, row, ext = _stick_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim)
         if cause is not None:
             result.append(cause)
@@ -222,41 +233,44 @@ def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
     mf, mv = kf.moving, kv.moving
     rf0 = residual(kf, model)[mf]
     rv0 = residual(kv, model)[mv]
-    chosen: list = []                      # (name, Phi_f, Phi_v, hyper, F, p, rms_before, rms_after)
+    # chosen: (name, Phi_f, Phi_v, hyper, F, p, rms_before, rms_after, gain, shift_f, shift_v);
+    # the extended model's force change is Pf theta + Sf (Sf: the chosen causes' known shifts)
+    chosen: list = []
     Pf = np.zeros((rf0.size, 0))
     Pv = np.zeros((rv0.size, 0))
+    Sf, Sv = np.zeros(rf0.size), np.zeros(rv0.size)
     rejected = []
     alone: dict = {}                       # step-1 fits that pass the criterion on their own
     for _ in range(max_causes):
-        th, *_ = np.linalg.lstsq(Pf, rf0, rcond=None) if Pf.shape[1] else (np.zeros(0),)
-        rf_cur = rf0 - Pf @ th
-        rv_cur = rv0 - Pv @ th
+        th, *_ = np.linalg.lstsq(Pf, rf0 - Sf, rcond=None) if Pf.shape[1] else (np.zeros(0),)
+        rf_cur = rf0 - Sf - Pf @ th
+        rv_cur = rv0 - Sv - Pv @ th
         ss0 = float(rf_cur @ rf_cur)
         best = None
         for name in names:
             if any(c[0] == name for c in chosen):
                 continue
             fits = []
-            for df, dv, hyper in _designs(name, kf, kv, model, mf, mv):
+            for df, dv, hyper, sf, sv in _designs(name, kf, kv, model, mf, mv):
                 A = np.column_stack([Pf, df])
-                t2, *_ = np.linalg.lstsq(A, rf0, rcond=None)
-                fits.append((float(np.sum((rf0 - A @ t2) ** 2)), df, dv, hyper, t2))
+                t2, *_ = np.linalg.lstsq(A, rf0 - Sf - sf, rcond=None)
+                fits.append((float(np.sum((rf0 - Sf - sf - A @ t2) ** 2)), df, dv, hyper, t2, sf, sv))
             if not fits:
                 continue
             # the simplest variant (first in the cause's list: e.g. the shortest cogging pitch, not
             # a multiple of it) among those within 0.1 % of the best fit
             ss_min = min(f[0] for f in fits)
-            ss1, df, dv, hyper, t2 = next(f for f in fits if f[0] <= ss_min * (1 + 1e-3))
+            ss1, df, dv, hyper, t2, sf, sv = next(f for f in fits if f[0] <= ss_min * (1 + 1e-3))
             k = df.shape[1]
             # effective sample size from the residual of the extended fit (the residual before it
             # is dominated by the very effect being tested, e.g. a smooth cogging force)
-            r1 = rf0 - np.column_stack([Pf, df]) @ t2
+            r1 = rf0 - Sf - sf - np.column_stack([Pf, df]) @ t2
             dof = max(_n_eff(r1) - Pf.shape[1] - k, 1.0)
             F = ((ss0 - ss1) / k) / max(ss1 / dof, 1e-300)
             p = float(stats.f.sf(F, k, dof))
-            rms_v = _rms(rv0 - np.column_stack([Pv, dv]) @ t2)
+            rms_v = _rms(rv0 - Sv - sv - np.column_stack([Pv, dv]) @ t2)
             gain = 1 - rms_v / _rms(rv_cur)
-            row = (name, df, dv, hyper, float(F), p, _rms(rv_cur), rms_v, gain)
+            row = (name, df, dv, hyper, float(F), p, _rms(rv_cur), rms_v, gain, sf, sv)
             why = getattr(CAUSES[name], "unphysical", lambda *a: None)(t2[Pf.shape[1]:], hyper, model)
             if p < alpha and gain >= min_gain and why:
                 rejected.append(dict(name=name, step=len(chosen) + 1, F=float(F), p_value=p, validation_gain=gain,
@@ -266,7 +280,7 @@ def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
                     alone[name] = (CAUSES[name].parameters(t2, hyper, model),
                                    dict(metric="force residual RMS [N], validation, alone", nominal=_rms(rv_cur),
                                         extended=rms_v))
-                if best is None or gain > best[-1]:
+                if best is None or gain > best[8]:
                     best = row
             else:
                 rejected.append(dict(name=name, step=len(chosen) + 1, F=float(F), p_value=p, validation_gain=gain))
@@ -275,28 +289,29 @@ def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
         chosen.append(best)
         Pf = np.column_stack([Pf, best[1]])
         Pv = np.column_stack([Pv, best[2]])
+        Sf, Sv = Sf + best[9], Sv + best[10]
         rejected = [r for r in rejected if r["step"] != len(chosen)]
     # final joint fit: parameters, uncertainties, drop-one scores
     result = []
     rv_ext = rv0.copy()
     if chosen:
-        th, *_ = np.linalg.lstsq(Pf, rf0, rcond=None)
-        r = rf0 - Pf @ th
+        th, *_ = np.linalg.lstsq(Pf, rf0 - Sf, rcond=None)
+        r = rf0 - Sf - Pf @ th
         # residual variance inflated by n / n_eff for the correlation of smoothed residuals
         s2 = float(r @ r) / max(r.size - Pf.shape[1], 1.0) * (r.size / max(_n_eff(r), 1.0))
         cov = np.linalg.pinv(Pf.T @ Pf) * s2
-        rv_ext = rv0 - Pv @ th
+        rv_ext = rv0 - Sv - Pv @ th
         full = _rms(rv_ext)
         col = 0
-        for (name, df, dv, hyper, F, p, before, after, gain) in chosen:
+        for (name, df, dv, hyper, F, p, before, after, gain, sf, sv) in chosen:
             k = df.shape[1]
             sl = slice(col, col + k)
             col += k
             keep = np.ones(Pf.shape[1], bool)
             keep[sl] = False
             if keep.any():
-                t_d, *_ = np.linalg.lstsq(Pf[:, keep], rf0, rcond=None)
-                dropped = _rms(rv0 - Pv[:, keep] @ t_d)
+                t_d, *_ = np.linalg.lstsq(Pf[:, keep], rf0 - Sf + sf, rcond=None)
+                dropped = _rms(rv0 - Sv + sv - Pv[:, keep] @ t_d)
             else:
                 dropped = _rms(rv0)
             mod = CAUSES[name]

@@ -1,7 +1,8 @@
 """Synthetic "measured" data with hidden effects, for tests that call the diagnosis blind.
 
 The true plant: m q'' = cm u(t - delay) + f_ext - F(q') - offset - F_cog(q), with Coulomb +
-viscous friction per direction (Fc+-, b+-; exact stick), optionally a Stribeck level (Fs, vs)
+viscous friction per direction (Fc+-, b+-; exact stick, or LuGre with bristle stiffness sigma0),
+optionally a Stribeck level (Fs, vs)
 with frictional memory (lag) and a dwell-time growth of the break-away force,
 F_cog = A sin(2 pi q / pitch), a random force disturbance; a 1 kHz PD position-velocity loop like
 the EMPS benchmark (u = kv (kp (q_ref - q) - v_f), v_f a backward difference of a 2-tap averaged
@@ -51,6 +52,7 @@ class TruePlant:
     rest: tuple = (0.2, 0.2)         # range of the rests between strokes [s]
     stroke_speed: tuple = (0.05, 0.15)   # range of the strokes' mean speeds [m/s]
     stroke: float = 0.2              # longest stroke [m]
+    sigma0: float = 0.0              # LuGre bristle stiffness [N/m] (0: static friction with exact stick)
 
 
 def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0, rest=(0.2, 0.2),
@@ -93,8 +95,11 @@ def true_model(true: TruePlant) -> NominalModel:
     if true.dac_step:
         ctrl["output_resolution"] = true.dac_step
     dwell = Dwell(0.0, true.dwell_gain, true.dwell_time) if true.dwell_gain else None
-    return NominalModel(true.mass, true.cm, curve, "stribeck" if dip else "coulomb-viscous", offset=true.offset,
-                        controller=ctrl, cogging=cog, delay=true.delay, lag=true.lag, dwell=dwell)
+    law = "lugre" if true.sigma0 else ("stribeck" if dip else "coulomb-viscous")
+    # LuGre's bristle damping at damping ratio 0.5 of the presliding resonance
+    s1 = float(np.sqrt(true.sigma0 * true.mass)) if true.sigma0 else None
+    return NominalModel(true.mass, true.cm, curve, law, offset=true.offset, controller=ctrl, cogging=cog,
+                        delay=true.delay, lag=true.lag, dwell=dwell, sigma0=true.sigma0 or None, sigma1=s1)
 
 
 def generate(true: TruePlant, duration: float = 20.0, seed: int = 0, substeps: int = 10) -> Measurement:

@@ -66,6 +66,15 @@ def stribeck_level_slope(vrel, Fc, Fs, vs, beta):
     return -(Fs - Fc) * math.exp(-pow_ext(r, beta)) * dpow / vs
 
 
+@numba.njit(cache=True, error_model="numpy")
+def _levels(a, Fc, Fs, vs, beta, slope):
+    """stribeck_level (or its slope) at each speed of a (n,)."""
+    out = np.empty(a.size)
+    for i in range(a.size):
+        out[i] = stribeck_level_slope(a[i], Fc, Fs, vs, beta) if slope else stribeck_level(a[i], Fc, Fs, vs, beta)
+    return out
+
+
 @numba.njit(cache=True, error_model="numpy", inline='always')
 def slip_force(v, s, Fc, Fs, vs, beta, b):
     """Friction force in slip with direction s = +1 / -1 (taken from the mode): s g(s v) + b v."""
@@ -119,16 +128,14 @@ class StribeckCurve:
         return (self.Fc, self.Fs, self.vs, beta, self.b)
 
     def level(self, v) -> np.ndarray:
-        """Stribeck level g(|v|) [N] (without the viscous part), for v != 0."""
+        """Stribeck level g(|v|) [N] (without the viscous part), for v != 0; v any shape."""
         v = np.abs(np.asarray(v, dtype=float))
-        Fc, Fs, vs, beta, _ = self.encoded()
-        return np.vectorize(lambda a: stribeck_level(a, Fc, Fs, vs, beta), otypes=[float])(v)
+        return _levels(v.ravel(), *self.encoded()[:4], False).reshape(v.shape)
 
     def level_slope(self, v) -> np.ndarray:
-        """d g / d|v| [N s/m] of the Stribeck level at speeds |v|."""
+        """d g / d|v| [N s/m] of the Stribeck level at speeds |v|; v any shape."""
         v = np.abs(np.asarray(v, dtype=float))
-        Fc, Fs, vs, beta, _ = self.encoded()
-        return np.vectorize(lambda a: stribeck_level_slope(a, Fc, Fs, vs, beta), otypes=[float])(v)
+        return _levels(v.ravel(), *self.encoded()[:4], True).reshape(v.shape)
 
     def force(self, v) -> np.ndarray:
         """Slip friction force [N] for velocities v (array); 0 where v == 0 (see stick_set)."""

@@ -5,8 +5,10 @@ hyper-parameter variants to try, chosen from the fitting data: e.g. cogging pitc
 extension's parameters) and ``parameters(theta, hyper, model)`` turning the fitted coefficients
 into named physical parameters, and ``extend(model, theta, hyper)`` returning the extended
 NominalModel (what the behaviour view re-simulates); optionally ``unphysical(theta, hyper, model)``
-returning why a fitted theta is not the physical effect (the cause is then rejected), else None. Adding a cause is adding a module and
-listing it here."""
+returning why a fitted theta is not the physical effect (the cause is then rejected), else None;
+optionally ``shift(kin, model, hyper)``: the known, unfitted part (n,) [N] of the extension's
+force change (e.g. the nominal Stribeck dip moved to a new vs). Adding a cause is adding a module
+and listing it here."""
 from ..model import NominalModel
 from ...models.friction import DirectionalCurve
 
@@ -19,9 +21,9 @@ def with_curves(model: NominalModel, pos, neg=None) -> NominalModel:
 
 
 from . import (asymmetry, cogging, delay, dwell, flexibility, lag, mass, offset, presliding,  # noqa: E402
-               quantization, saturation, stribeck, viscous)
+               quantization, reversal, saturation, stribeck, viscous)
 
-CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, stribeck, viscous, mass, delay, flexibility, lag, presliding, dwell,
-                                saturation, quantization)}
+CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, stribeck, viscous, mass, delay, flexibility, lag, reversal,
+                                presliding, dwell, saturation, quantization)}
 
 __all__ = ["CAUSES"]

@@ -11,7 +11,7 @@ HARMONICS = 3
 
 def hypers(kin, model) -> list:
     """Pitch candidates: the three strongest peaks of the Lomb-Scargle spectrum of the nominal
-    force residual against position (wavelengths from 20 samples' travel at the typical speed to
+    force residual (averaged in position bins) against position (wavelengths from 20 samples' travel at the typical speed to
     a quarter of the stroke), each refined on a +-3 % grid of 0.2 % steps."""
     from scipy.signal import lombscargle
     from ..kinematics import residual
@@ -25,7 +25,16 @@ def hypers(kin, model) -> list:
     if not (lo > 0 and hi > lo):
         return []
     k = np.geomspace(1 / hi, 1 / lo, 1500)                  # wavenumbers [1/m], 0.2-0.4 % apart
-    power = lombscargle(q, r - r.mean(), 2 * np.pi * k)
+    # the spectrum of the residual averaged in position bins of a tenth of the shortest
+    # wavelength: what is periodic in q survives the averaging, the cost falls from the samples
+    # (tens of thousands, visited again and again) to the bins
+    width = lo / 10
+    idx = np.floor((q - q.min()) / width).astype(np.int64)
+    counts = np.bincount(idx)
+    full = counts > 0
+    qb = (np.bincount(idx, q)[full]) / counts[full]
+    rb = (np.bincount(idx, r)[full]) / counts[full]
+    power = lombscargle(qb, rb - rb.mean(), 2 * np.pi * k)
     peaks = [i for i in range(1, k.size - 1) if power[i] >= power[i - 1] and power[i] >= power[i + 1]]
     peaks = sorted(peaks, key=lambda i: -power[i])[:3]
     out = []

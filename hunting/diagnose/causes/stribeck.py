@@ -1,5 +1,8 @@
-"""A wrong velocity-weakening shape: Coulomb level change c1 sign(v) plus a Stribeck term
-c2 sign(v) exp(-(|v|/vs)^2) with vs searched on a logarithmic grid over the measured speeds."""
+"""A wrong velocity-weakening shape: the curve of each direction becomes
+(Fc + c1) + (Fs - Fc + c2) exp(-(|v|/vs)^2) + b |v|, with vs searched on a logarithmic grid over
+the measured speeds (and the nominal's own vs). The change against the nominal curve is
+c1 sign(v) + c2 sign(v) exp(-(|v|/vs)^2) (fitted) plus the known move of the nominal dip
+Fs - Fc from its shape to the new one (``shift``)."""
 from dataclasses import replace
 
 import numpy as np
@@ -15,7 +18,11 @@ def hypers(kin, model) -> list:
     if speed.size < 10:
         return []
     lo, hi = np.percentile(speed, 2), np.percentile(speed, 90)
-    return [{"vs": float(vs)} for vs in np.geomspace(max(lo, 1e-9), max(hi, 2e-9), 16)]
+    grid = [float(vs) for vs in np.geomspace(max(lo, 1e-9), max(hi, 2e-9), 16)]
+    own = model.curve.positive.vs
+    if model.curve.positive.Fs != model.curve.positive.Fc and lo < own < hi:
+        grid.append(float(own))
+    return [{"vs": vs} for vs in sorted(grid)]
 
 
 def design(kin, model, hyper):
@@ -23,23 +30,37 @@ def design(kin, model, hyper):
     return kin.filtered(np.column_stack([s, s * np.exp(-(np.abs(kin.v) / hyper["vs"]) ** 2)]))
 
 
+def shift(kin, model, hyper) -> np.ndarray:
+    """The nominal dip Fs - Fc of each direction moved from its own shape to exp(-(|v|/vs)^2)
+    [N] (n,): zero for a curve without a dip."""
+    v = kin.v
+    out = np.zeros_like(v)
+    for c, side in ((model.curve.positive, v > 0), (model.curve.negative, v < 0)):
+        dip = c.Fs - c.Fc
+        if dip:
+            a = np.abs(v[side])
+            out[side] = np.sign(v[side]) * dip * (np.exp(-(a / hyper["vs"]) ** 2) - np.exp(-(a / c.vs) ** c.beta))
+    return kin.filtered(out)
+
+
 def unphysical(theta, hyper, model) -> str | None:
-    if theta[1] < 0:
-        return (f"Fs - Fc = {theta[1]:.3g} N < 0 (friction rising with speed at low speed); a force dip at low "
-                "speed through reversals is frictional memory (lag) or presliding, not a Stribeck curve")
+    dip = min(model.curve.positive.Fs - model.curve.positive.Fc, model.curve.negative.Fs - model.curve.negative.Fc)
+    if dip + theta[1] < 0:
+        return (f"Fs - Fc = {dip + theta[1]:.3g} N < 0 (friction rising with speed at low speed); a force dip at "
+                "low speed through reversals is frictional memory (lag) or presliding, not a Stribeck curve")
     return None
 
 
 def parameters(theta, hyper, model) -> dict:
     c = model.curve.positive
-    return {"Fc": float(c.Fc + theta[0]), "Fs": float(c.Fc + theta[0] + theta[1]), "vs": hyper["vs"]}
+    Fc = float(c.Fc + theta[0])
+    return {"Fc": Fc, "Fs": float(Fc + c.Fs - c.Fc + theta[1]), "vs": hyper["vs"]}
 
 
 def extend(model, theta, hyper):
-    """Levels Fc + theta0 and Fs = Fc + theta0 + theta1 at the fitted vs (replacing the curve's
-    own Stribeck term when it had one)."""
+    """Levels Fc + theta0 and Fs - Fc grown by theta1, at the fitted vs with beta = 2."""
     def new(c):
         Fc = max(c.Fc + float(theta[0]), 0.0)
-        return replace(c, Fc=Fc, Fs=Fc + float(theta[1]), vs=hyper["vs"], beta=2.0)
+        return replace(c, Fc=Fc, Fs=Fc + (c.Fs - c.Fc) + float(theta[1]), vs=hyper["vs"], beta=2.0)
     out = with_curves(model, new)
     return out.replace(law="stribeck") if model.law == "coulomb-viscous" else out

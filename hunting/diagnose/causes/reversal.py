@@ -1,0 +1,82 @@
+"""Presliding after velocity reversals: the friction force does not jump to the opposite level
+when the velocity changes sign but builds up over a slip of about Fc / sigma0 (LuGre's
+transient, thesis chapter 4), for data that never rest (the stick-channel ``presliding`` needs
+rests).
+
+A force-channel cause with sigma0 as hyper-parameter (a logarithmic grid of slip lengths
+Fc / sigma0 from 2 encoder counts to 5 mm): the LuGre bristle state is integrated along the
+measured velocity (exactly for piecewise-constant v:
+z <- z_ss + (z - z_ss) exp(-sigma0 |v| dt / g), z_ss = sign(v) g / sigma0, g the nominal
+Stribeck level of that direction), and the regressor is the change of the friction force
+sigma0 z + sigma1 z' - sign(v) g(|v|) (sigma1 as in the extension: right after a reversal
+z' = 2 v, and the bristle damping dominates the transient). Its
+coefficient ``scale`` is 1 for LuGre: the whole level builds up after a reversal. A fit far from
+1 (outside [0.5, 2]) is a friction deficit near reversals of another kind, and the cause is
+rejected as not physical.
+
+The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 as in
+:mod:`presliding` (damping ratio 0.5 of the presliding resonance)."""
+import numba
+import numpy as np
+
+from . import presliding
+
+NAME = "reversal"
+DESCRIPTION = "presliding after velocity reversals: friction builds up over a slip Fc/sigma0 (LuGre)"
+SCALE_RANGE = (0.5, 2.0)
+
+
+@numba.njit(cache=True)
+def _bristle(v, dt, g_pos, g_neg, sigma0):
+    """LuGre bristle deflection z [m] (n,) along the velocity v (n,) [m/s] sampled at dt, with
+    the steady levels g_pos, g_neg (n,) [N] of each direction, from the steady state of the
+    first sample's direction."""
+    z = np.empty(v.size)
+    zk = (g_pos[0] if v[0] >= 0.0 else -g_neg[0]) / sigma0
+    for k in range(v.size):
+        g = g_pos[k] if v[k] >= 0.0 else g_neg[k]
+        z_ss = (g if v[k] >= 0.0 else -g) / sigma0
+        zk = z_ss + (zk - z_ss) * np.exp(-sigma0 * abs(v[k]) * dt / g)
+        z[k] = zk
+    return z
+
+
+def hypers(kin, model) -> list:
+    if model.law == "lugre":
+        return []                          # the nominal model has presliding already
+    Fc = min(model.curve.positive.Fc, model.curve.negative.Fc)
+    if Fc <= 0:
+        return []
+    from ..resimulate import resolution_of
+    shortest = max(2 * resolution_of(kin.q), 1e-7)
+    return [{"sigma0": float(Fc / x)} for x in np.geomspace(5e-3, min(shortest, 5e-4), 25)]
+
+
+def design(kin, model, hyper):
+    v = kin.v
+    a = np.abs(v)
+    g_pos = model.curve.positive.level(a)
+    g_neg = model.curve.negative.level(a)
+    s0 = hyper["sigma0"]
+    s1 = presliding.parameters(np.array([1.0 / s0]), {}, model)["sigma1"]
+    g = np.where(v >= 0, g_pos, g_neg)
+    z = _bristle(np.ascontiguousarray(v), float(kin.t[1] - kin.t[0]), g_pos, g_neg, s0)
+    zdot = v - s0 * a * z / g
+    return kin.filtered(s0 * z + s1 * zdot - np.sign(v) * g)[:, None]
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    lo, hi = SCALE_RANGE
+    if not lo <= theta[0] <= hi:
+        return (f"the friction change after reversals is {theta[0]:.2f} times LuGre's (sigma0 = {hyper['sigma0']:.3g} "
+                f"N/m); LuGre builds up the whole level (1; accepted {lo:g}..{hi:g}): a friction deficit near "
+                "reversals of another kind")
+    return None
+
+
+def parameters(theta, hyper, model) -> dict:
+    return {"sigma0": hyper["sigma0"], "scale": float(theta[0])}
+
+
+def extend(model, theta, hyper):
+    return presliding.extend(model, np.array([1.0 / hyper["sigma0"]]), {})
