@@ -3,8 +3,8 @@ when the velocity changes sign but builds up over a slip of about Fc / sigma0 (L
 transient, thesis chapter 4), for data that never rest (the stick-channel ``presliding`` needs
 rests).
 
-A force-channel cause with sigma0 as hyper-parameter (a logarithmic grid of slip lengths
-Fc / sigma0 from 2 encoder counts to 5 mm): the LuGre bristle state is integrated along the
+A force-channel cause with sigma0 as hyper-parameter (a logarithmic grid of 25 slip lengths
+Fc / sigma0 from 5 mm down to two counts of the model's sensor resolution, or 0.1 um): the LuGre bristle state is integrated along the
 measured velocity (exactly for piecewise-constant v:
 z <- z_ss + (z - z_ss) exp(-sigma0 |v| dt / g), z_ss = sign(v) g / sigma0, g the nominal
 Stribeck level of that direction), and the regressor is the change of the friction force
@@ -47,8 +47,7 @@ def hypers(kin, model) -> list:
     Fc = min(model.curve.positive.Fc, model.curve.negative.Fc)
     if Fc <= 0:
         return []
-    from ..resimulate import resolution_of
-    shortest = max(2 * resolution_of(kin.q), 1e-7)
+    shortest = max(2 * (model.resolution or 0.0), 1e-7)
     return [{"sigma0": float(Fc / x)} for x in np.geomspace(5e-3, min(shortest, 5e-4), 25)]
 
 
