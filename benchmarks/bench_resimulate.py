@@ -16,11 +16,11 @@ stop (v = 0) is located by Newton on the step length, not by interpolation.
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from _timing import best_of
 from hunting.diagnose import NominalModel
 from hunting.diagnose.data import Measurement
 from hunting.diagnose.resimulate import resimulate
@@ -30,13 +30,6 @@ SET = {"P": 20.0}
 FLOOR = 1e-12            # [m] errors below this are rounding (|q| <= 0.5)
 
 
-def best_of(fn, repeat=3):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def scipy_loop(model: NominalModel, n: int, rtol: float) -> np.ndarray:
@@ -101,7 +94,7 @@ def main() -> None:
     rows = {}
     for sub in (4, 10, 20, 40):
         ours(sub)
-        el, q = best_of(lambda: ours(sub))
+        el, q = best_of(lambda: ours(sub), repeat=3)
         rows[f"hunting substeps={sub}"] = (el, float(np.max(np.abs(q - ref))))
     for rtol in (1e-6, 1e-8, 1e-10):
         el, q = best_of(lambda: scipy_loop(model, n, rtol), repeat=1)

@@ -15,7 +15,6 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -25,19 +24,13 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import hunting  # noqa: E402
 from hunting.models import servo as S  # noqa: E402
+from _timing import best_of  # noqa: E402
 from reference import scipy_switch_sequence  # noqa: E402
 
 RTOL, ATOL = 1e-10, 1e-12
 N_EVENTS = 50
 
 
-def best_of(fn, repeat=5):
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def startup_times() -> tuple[float, float]:

@@ -94,6 +94,16 @@ def plot_hysteresis(force, displacement, *, title: str = "", path=None, units=("
     return fig
 
 
+def cobweb_path(xs) -> tuple[list, list]:
+    """The cobweb of the iterates xs = (d_0, d_1, ...) of a map: from (d_0, 0) up to the map at
+    (d_0, d_1), across to the diagonal at (d_1, d_1), up to (d_1, d_2), ... Returns (px, py)."""
+    px, py = [xs[0]], [0.0]
+    for a, b in zip(xs[:-1], xs[1:]):
+        px += [a, b]
+        py += [b, b]
+    return px, py
+
+
 def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), title: str = "", ax=None,
                    path=None, unit: str = "m"):
     """P^k(d) against d with the diagonal; optional cobweb from ``cobweb_from`` (iterating the
@@ -114,11 +124,7 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
             if not mv.ok[0]:
                 break
             xs.append(float(mv.image[0]))
-        px, py = [xs[0]], [0.0]
-        for a, b in zip(xs[:-1], xs[1:]):
-            px += [a, b]
-            py += [b, b]
-        ax.plot(px, py, "-", color="C3", lw=0.9, label="cobweb")
+        ax.plot(*cobweb_path(xs), "-", color="C3", lw=0.9, label="cobweb")
         ax.plot(xs[:-1], xs[1:], "o", color="C3", ms=4)
     for f in fixed:
         for d in ([f.d] if f.kind == "equilibrium" else [f.d, -f.d] if em.loop.odd and em.grid.min() < 0 else [f.d]):

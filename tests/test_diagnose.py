@@ -306,19 +306,13 @@ def test_wrong_stribeck_level_is_found_and_the_event_map_follows(tmp_path):
     channel must move the Stribeck level back (the nominal dip kept, not dropped), and the
     extended model's re-simulated event map must match the measured one where the nominal's
     does not (its hunting cycle is a third of the measured amplitude)."""
-    from hunting.diagnose.data import Measurement
     from hunting.diagnose.report import write_report
-    from hunting.diagnose.resimulate import resimulate
+    from hunting.diagnose.synthetic import regulator
     true = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 20.0}})
     nominal = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 20.0, "Fs": 3.0}})
-    dt, n = 1e-3, 40_000
-
-    def run(d0, seed):
-        t = np.arange(n) * dt
-        rest = Measurement(t, np.full(n, d0), np.zeros(n), q_ref=np.zeros(n))
-        sim = resimulate(rest, true, resolution=1e-5, force_noise=np.random.default_rng(seed).normal(0, 0.05, n))
-        return Measurement(t, sim.q, sim.u, q_ref=np.zeros(n))
-    dg = diagnose(run(0.5, 1), nominal, run(0.4, 2), causes=["offset", "stribeck", "presliding"])
+    fit, val = (regulator(true, d0, 40_000, 1e-3, seed=seed, resolution=1e-5, force_noise=0.05)
+                for d0, seed in ((0.5, 1), (0.4, 2)))
+    dg = diagnose(fit, nominal, val, causes=["offset", "stribeck", "presliding"])
     assert [c.name for c in dg.causes] == ["stribeck"]
     p, s = dg.causes[0].parameters, dg.causes[0].sigma
     assert p["Fs"] == pytest.approx(4.0, abs=max(3 * s["Fs"], 0.01)) and p["Fc"] == pytest.approx(2.0, abs=0.01)

@@ -10,12 +10,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 from hunting.diagnose import NominalModel, diagnose, fit_coulomb_viscous, kinematics, load
-from hunting.diagnose.data import Measurement
 from hunting.diagnose.report import write_report
-from hunting.diagnose.resimulate import resimulate
+from hunting.diagnose.synthetic import regulator
 
 HERE = Path(__file__).resolve().parent
 EMPS = HERE.parents[1].parent / "shared" / "data" / "emps"
@@ -44,14 +41,9 @@ def emps() -> None:
 def table91_event_map() -> None:
     true = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 20.0}})
     nominal = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 20.0, "Fs": 3.0}})
-    dt, n = 1e-3, 40_000
-
-    def run(d0, seed):
-        t = np.arange(n) * dt
-        rest = Measurement(t, np.full(n, d0), np.zeros(n), q_ref=np.zeros(n))
-        sim = resimulate(rest, true, resolution=1e-5, force_noise=np.random.default_rng(seed).normal(0, 0.05, n))
-        return Measurement(t, sim.q, sim.u, q_ref=np.zeros(n))
-    dg = diagnose(run(0.5, 1), nominal, run(0.4, 2), causes=["offset", "stribeck", "presliding"])
+    fit, val = (regulator(true, d0, 40_000, 1e-3, seed=seed, resolution=1e-5, force_noise=0.05)
+                for d0, seed in ((0.5, 1), (0.4, 2)))
+    dg = diagnose(fit, nominal, val, causes=["offset", "stribeck", "presliding"])
     _report(dg, {"event_map.png": "diagnose_event_map.png"})
 
 

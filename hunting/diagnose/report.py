@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotting import _plt, save
+from ..plotting import _plt, cobweb_path, save
 from .select import Diagnosis
 
 
@@ -88,11 +88,7 @@ def event_map_figure(dg: Diagnosis, path) -> None:
                 break
             chain.append(pt)
         xs = [c[0] for c in chain[::-1]] + [chain[0][1]]
-        px, py = [xs[0]], [xs[0]]
-        for a, c in zip(xs[:-1], xs[1:]):
-            px += [a, c]
-            py += [c, c]
-        ax.plot(px, py, "-", color="k", lw=0.6, alpha=0.6, label="cobweb (measured, last steps)")
+        ax.plot(*cobweb_path(xs), "-", color="k", lw=0.6, alpha=0.6, label="cobweb (measured, last steps)")
     for pts, style, lab in zip(every, ("ko", "C3x", "C0+"), ("measured", "nominal", "extended")):
         c = b[lab]["map_contraction"]
         note = "" if c is None else f", |d$_{{n+1}}$|/|d$_n$| = {c:.3g}"

@@ -221,21 +221,14 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                 # step's length from the linear estimate, so the stop is as accurate as the
                 # steps), then decide stick or slip for the rest of the substep
                 th = s * v / (s * v - s * vn) if s * v - s * vn > 0.0 else 1.0
-                q1, z1 = q + th * (qn - q), z + th * (zn - z)
-                for _ in range(4):
+                for it in range(5):
                     qa, va, za = _rk4(q, v, z, s, fa, th * rem, p, cog, bases)
                     acc = _rates(qa, va, za, s, fa, p, cog, bases)[1]
-                    if acc == 0.0:
-                        break
-                    th_new = th - va / (rem * acc)
-                    if not 0.0 < th_new <= 1.0:
-                        break
-                    q1, z1 = qa, za
-                    done_newton = abs(th_new - th) <= 1e-13
+                    th_new = th - va / (rem * acc) if acc != 0.0 else th
+                    if it == 4 or not 0.0 < th_new <= 1.0 or abs(th_new - th) <= 1e-13:
+                        break              # (qa, za) is the state at th
                     th = th_new
-                    if done_newton:
-                        break
-                q, z = q1, z1
+                q, z = qa, za
                 v = 0.0
                 stuck = True
                 t_rest = 0.0

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..models.friction import DirectionalCurve, StribeckCurve
 from ..models.plant import Cogging
+from .causes.presliding import bristle_damping
 from .data import Measurement
 from .model import Dwell, NominalModel
 from .resimulate import resimulate
@@ -96,10 +97,21 @@ def true_model(true: TruePlant) -> NominalModel:
         ctrl["output_resolution"] = true.dac_step
     dwell = Dwell(0.0, true.dwell_gain, true.dwell_time) if true.dwell_gain else None
     law = "lugre" if true.sigma0 else ("stribeck" if dip else "coulomb-viscous")
-    # LuGre's bristle damping at damping ratio 0.5 of the presliding resonance
-    s1 = float(np.sqrt(true.sigma0 * true.mass)) if true.sigma0 else None
+    s1 = bristle_damping(true.sigma0, true.mass) if true.sigma0 else None
     return NominalModel(true.mass, true.cm, curve, law, offset=true.offset, controller=ctrl, cogging=cog,
                         delay=true.delay, lag=true.lag, dwell=dwell, sigma0=true.sigma0 or None, sigma1=s1)
+
+
+def regulator(model: NominalModel, d0: float, n: int, dt: float, *, seed: int = 0, resolution: float = 0.0,
+              force_noise: float = 0.0, substeps: int = 20) -> Measurement:
+    """A regulator task measured on ``model`` (its own controller): n samples at dt [s] from
+    rest at error d0 [m] with q_ref = 0, the encoder quantizing to ``resolution`` [m] (0: none),
+    a white force disturbance of standard deviation ``force_noise`` [N] drawn with ``seed``."""
+    t = np.arange(n) * dt
+    rest = Measurement(t, np.full(n, d0), np.zeros(n), q_ref=np.zeros(n))
+    noise = np.random.default_rng(seed).normal(0.0, force_noise, n) if force_noise else None
+    sim = resimulate(rest, model, resolution=resolution, force_noise=noise, substeps=substeps)
+    return Measurement(t, sim.q, sim.u, q_ref=np.zeros(n), name=f"regulator(d0={d0:g}, seed={seed})")
 
 
 def generate(true: TruePlant, duration: float = 20.0, seed: int = 0, substeps: int = 10) -> Measurement:

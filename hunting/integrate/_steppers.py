@@ -207,6 +207,17 @@ def numerical_jacobian(vf, mode, t, y, f, p, rtol, atol, J, ytmp, ftmp):
             J[i, j] = (ftmp[i] - f[i]) / dj
 
 
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def _stage_block_column(Ms, h, b, J, nb):
+    """Block column b of the stage matrix without its identity: Ms[a nb + i, b nb + j] =
+    -h A[a, b] J[i, j] for the three stages a (J the Jacobian at stage b, or one for all)."""
+    for a in range(3):
+        hab = h * RADAU_A[a, b]
+        for i in range(nb):
+            for j in range(nb):
+                Ms[a * nb + i, b * nb + j] = -hab * J[i, j]
+
+
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
 def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
                R, ytmp, y_new, f_new, err):
@@ -230,12 +241,8 @@ def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, 
     k3 = 3 * nb
     Ms = M[:k3, :k3]
     Rs = R[:k3]
-    for a in range(3):
-        for b in range(3):
-            hab = h * RADAU_A[a, b]
-            for i in range(nb):
-                for j in range(nb):
-                    Ms[a * nb + i, b * nb + j] = -hab * J[i, j]
+    for b in range(3):
+        _stage_block_column(Ms, h, b, J, nb)
     for k in range(k3):
         Ms[k, k] += 1.0
     if not lu_factor(Ms, piv):
@@ -291,11 +298,7 @@ def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, 
             for i in range(nb):
                 yw[i] = y[i] + Z[b, i]
             nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, tb, yw, p, Jw, fp, fm, nb)
-            for a in range(3):
-                hab = h * RADAU_A[a, b]
-                for i in range(nb):
-                    for k in range(nb):
-                        Ms[a * nb + i, b * nb + k] = -hab * Jw[i, k]
+            _stage_block_column(Ms, h, b, Jw, nb)
             for i in range(nb):
                 for j in range(mc):
                     acc = 0.0

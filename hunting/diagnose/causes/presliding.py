@@ -149,9 +149,15 @@ def fit_behaviour(meas, model, *, max_evals: int = 14) -> tuple[np.ndarray, floa
     return np.array([10.0 ** -best]), cache[best]
 
 
+def bristle_damping(sigma0: float, mass: float) -> float:
+    """sigma1 [N s/m] at damping ratio ZETA of the presliding resonance of ``mass`` [kg] on
+    ``sigma0`` [N/m]: what creeping data cannot determine."""
+    return float(np.sqrt(sigma0 * mass)) * 2 * ZETA
+
+
 def parameters(theta, hyper, model) -> dict:
     sigma0 = 1.0 / theta[0] if theta[0] > 0 else float("inf")
-    return {"sigma0": float(sigma0), "sigma1": float(np.sqrt(sigma0 * model.mass)) * 2 * ZETA}
+    return {"sigma0": float(sigma0), "sigma1": bristle_damping(sigma0, model.mass)}
 
 
 def extend(model, theta, hyper):

@@ -57,7 +57,7 @@ def design(kin, model, hyper):
     g_pos = model.curve.positive.level(a)
     g_neg = model.curve.negative.level(a)
     s0 = hyper["sigma0"]
-    s1 = presliding.parameters(np.array([1.0 / s0]), {}, model)["sigma1"]
+    s1 = presliding.bristle_damping(s0, model.mass)
     g = np.where(v >= 0, g_pos, g_neg)
     z = _bristle(np.ascontiguousarray(v), float(kin.t[1] - kin.t[0]), g_pos, g_neg, s0)
     zdot = v - s0 * a * z / g
