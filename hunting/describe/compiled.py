@@ -185,13 +185,14 @@ class CompiledModel:
         """The flat parameter array with named values replaced (checked, not stored)."""
         new = np.array(self.system.params, dtype=np.float64)
         for k, v in {**(values or {}), **kw}.items():
+            slot = self.layout.param(k)
             try:
                 val = float(v)
             except (TypeError, ValueError):
                 raise SystemDefinitionError(f"parameter {k} = {v!r} is not a number") from None
             if not math.isfinite(val):
                 raise SystemDefinitionError(f"parameter {k} = {v!r} is not allowed: values must be finite")
-            new[self.layout.param(k)] = val
+            new[slot] = val
         self._spec.check_parameter_values(dict(zip(self.param_names, new)))
         return new
 
@@ -225,8 +226,9 @@ class CompiledModel:
             if c.model == "lugre":
                 x[self.layout.state(c.state)] = c.z0
         for k, v in named.items():
+            i = self.layout.state(k)
             try:
-                x[self.layout.state(k)] = float(v)
+                x[i] = float(v)
             except (TypeError, ValueError):
                 raise SystemDefinitionError(f"state {k} = {v!r} is not a number") from None
         return self.system.check_state(x)
