@@ -383,3 +383,117 @@ def test_lugre_fold_of_the_described_loop():
                         amplitude=servo_amplitude)
     fold = next(s for s in br.special if s.kind == "fold")
     assert fold.param == pytest.approx(0.6203, abs=5e-5)
+
+
+STACKED = {
+    "name": "stacked blocks",
+    "parameters": {"m1": 1.0, "m2": 0.5, "k1": 1.0, "k2": 0.5, "A": 2.0, "om": 1.3,
+                   "FcA": 0.8, "FsA": 1.0, "FcB": 0.3, "FsB": 0.4, "vs": 0.1},
+    "states": ["q1", "v1", "q2", "v2"],
+    "signals": {"u1": "-k1*q1", "u2": "-k2*q2 + A*sin(om*t)"},
+    "equations": {"q1": "v1", "v1": "(u1 - FA + FB)/m1", "q2": "v2", "v2": "(u2 - FB)/m2"},
+    "friction": [
+        {"name": "ground", "force": "FA", "velocity": "v1", "model": "switch",
+         "slip": "sign(w)*(FcA + (FsA - FcA)*exp(-(w/vs)**2))", "stick": "FsA"},
+        {"name": "top", "force": "FB", "velocity": "v2 - v1", "model": "switch",
+         "slip": "sign(w)*(FcB + (FsB - FcB)*exp(-(w/vs)**2))", "stick": "FsB"}]}
+
+
+def _stacked_reference(p, T, n_events):
+    """Block 2 on block 1 on the ground, block 2 driven by A sin(om t): an event-driven
+    solve_ivp with the stick forces of each contact pair written out by hand."""
+    from scipy.integrate import solve_ivp
+    P = p
+
+    def law(w, s, Fc, Fs):
+        return s * (Fc + (Fs - Fc) * np.exp(-(w / P["vs"]) ** 2))
+
+    def forces(t, y, a, b):
+        q1, v1, q2, v2 = y
+        u1, u2 = -P["k1"] * q1, -P["k2"] * q2 + P["A"] * np.sin(P["om"] * t)
+        m1, m2 = P["m1"], P["m2"]
+        FA = law(v1, a, P["FcA"], P["FsA"]) if a else None
+        FB = law(v2 - v1, b, P["FcB"], P["FsB"]) if b else None
+        if a == 0 and b == 0:
+            FB = u2
+            FA = u1 + u2
+        elif a == 0:
+            FA = u1 + FB                                  # v1' = 0
+        elif b == 0:
+            FB = (m1 * u2 - m2 * (u1 - FA)) / (m1 + m2)   # v1' = v2'
+        return u1, u2, FA, FB
+
+    def rhs(t, y, a, b):
+        u1, u2, FA, FB = forces(t, y, a, b)
+        return [y[1], (u1 - FA + FB) / P["m1"], y[3], (u2 - FB) / P["m2"]]
+
+    def settle(t, y, a, b):
+        for _ in range(3):
+            _, _, FA, FB = forces(t, y, a, b)
+            if a == 0 and abs(FA) > P["FsA"]:
+                a = int(np.sign(FA))
+            elif b == 0 and abs(FB) > P["FsB"]:
+                b = int(np.sign(FB))
+            else:
+                break
+        return a, b
+
+    t, y = 0.0, np.zeros(4)
+    a, b = settle(t, y, 0, 0)
+    times, states, modes = [], [], []
+    while t < T and len(times) < n_events:
+        evs = []
+        if a:
+            evs.append(("A0", lambda t, y: y[1], -a))
+        else:
+            evs += [("A+", lambda t, y: forces(t, y, a, b)[2] - P["FsA"], 1),
+                    ("A-", lambda t, y: forces(t, y, a, b)[2] + P["FsA"], -1)]
+        if b:
+            evs.append(("B0", lambda t, y: y[3] - y[1], -b))
+        else:
+            evs += [("B+", lambda t, y: forces(t, y, a, b)[3] - P["FsB"], 1),
+                    ("B-", lambda t, y: forces(t, y, a, b)[3] + P["FsB"], -1)]
+        fns = []
+        for _, fn, d in evs:
+            fn.terminal, fn.direction = True, d
+            fns.append(fn)
+        sol = solve_ivp(lambda t, y: rhs(t, y, a, b), (t, T), y, method="DOP853", rtol=1e-12, atol=1e-14,
+                        events=fns)
+        t, y = sol.t[-1], sol.y[:, -1].copy()
+        if sol.status != 1:
+            break
+        which = next(name for (name, _, _), te in zip(evs, sol.t_events) if te.size)
+        if which == "A0":
+            y[1], a = 0.0, 0
+        elif which == "B0":
+            y[3], b = y[1], 0
+        elif which[0] == "A":
+            a = 1 if which == "A+" else -1
+        else:
+            b = 1 if which == "B+" else -1
+        a, b = settle(t, y, a, b)
+        times.append(t)
+        states.append(y.copy())
+        modes.append((a, b))
+    return np.array(times), np.array(states), modes
+
+
+def test_two_contacts_stacked_blocks_against_solve_ivp():
+    m0 = hunting.model(STACKED)
+    assert len(m0.mode_names) == 9 and m0.mode_names[8] == "ground:stick,top:stick"
+    ground, top = m0.contacts
+    assert (ground.surface_state, top.surface_state) == (1, 3)     # top moves v2 onto v1, not v1
+    part = {"slip+": 1, "slip-": -1, "stick": 0}
+    seen = set()
+    for A, om in ((2.0, 1.3), (1.2, 0.5)):        # every slip/stick pair; both stuck in the second
+        m = m0.with_params(A=A, om=om)
+        tr = hunting.simulate(m.system, m.state(), (0.0, 25.0), rtol=1e-12, atol=1e-14)
+        assert tr.success
+        t_ref, x_ref, modes = _stacked_reference(dict(zip(m.param_names, m.params)), 25.0, len(tr.events))
+        got = [(part[ground.part(k)], part[top.part(k)]) for k in tr.events.mode_to]
+        n = len(t_ref)
+        assert n >= 6 and got[:n] == modes
+        np.testing.assert_allclose(tr.events.t[:n], t_ref, atol=1e-9)
+        np.testing.assert_allclose(tr.events.x_after[:n], x_ref, atol=1e-9)
+        seen |= set(modes)
+    assert {(0, 0), (0, 1), (0, -1), (1, 1), (-1, -1)} <= seen
