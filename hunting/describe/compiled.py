@@ -202,9 +202,10 @@ class CompiledModel:
         Examples
         --------
         >>> import hunting
-        >>> m = hunting.model("examples/belt.json")           # doctest: +SKIP
-        >>> m.with_params(k=3.0).system.param("k")            # doctest: +SKIP
-        3.0
+        >>> m = hunting.model({"parameters": {"k": 1.0, "c": 0.1}, "states": ["q", "v"],
+        ...                    "equations": {"q": "v", "v": "-k*q - c*v"}})
+        >>> m.with_params(k=3.0).system.param("k"), m.system.param("k")
+        (3.0, 1.0)
         """
         new = copy.copy(self)
         new.system = self.system.with_param_array(self.params_with(values, **kw))
@@ -216,8 +217,11 @@ class CompiledModel:
 
         Examples
         --------
-        >>> m.state(q=0.1)                                    # doctest: +SKIP
-        array([0.1, 0. ])
+        >>> import hunting
+        >>> m = hunting.model({"parameters": {"k": 1.0, "c": 0.1}, "states": ["q", "v"],
+        ...                    "equations": {"q": "v", "v": "-k*q - c*v"}})
+        >>> m.state(q=0.1).tolist()
+        [0.1, 0.0]
         """
         x = np.zeros(self.n_states)
         for k, v in self._spec.initial.items():
