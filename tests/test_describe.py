@@ -552,3 +552,27 @@ def test_docstring_examples():
     for mod in (api, compiled):
         res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
         assert res.failed == 0 and res.attempted > 0
+
+
+def test_servo_loop_description_with_cogging_and_asymmetric_friction():
+    """ServoLoop.description(): gains form, direction-dependent curve, cogging harmonics and a
+    constant force, against the hand-written kernel (vector field and guards in every mode)."""
+    from hunting.models import PID, Cogging, Plant, ServoLoop, StribeckCurve, Switch
+    from hunting.models.friction import DirectionalCurve
+    loop = ServoLoop(Plant(2.0, 1.5, setpoint=0.01, cogging=Cogging.harmonic(0.02, cos=[0.3, 0.1], sin=[0.2, 0.0]),
+                           external_force=0.4),
+                     Switch(DirectionalCurve(StribeckCurve(1.0, 1.5, 0.05, 0.7, 0.2), StribeckCurve(0.8, 1.1, 0.03, 2.0, 0.3))),
+                     PID(20.0, 3.0, 10.0))
+    m = loop.as_model()
+    assert set(m.param_names) >= {"kp", "kd", "ki", "Fc_neg", "cog_a2", "f_ext"}
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        x = rng.normal(size=3) * [0.01, 0.1, 0.01]
+        for mode in range(3):
+            x = x * [1, 0, 1] if mode == 2 else x          # stick holds x2 = 0
+            np.testing.assert_allclose(m.system.evaluate(x, mode=mode), loop.system.evaluate(x, mode=mode),
+                                       rtol=1e-12, atol=1e-12)
+            np.testing.assert_allclose(m.system.guard_values(x, mode=mode), loop.system.guard_values(x, mode=mode),
+                                       rtol=1e-12, atol=1e-12)
+        xr = x * [1, 0, 1]
+        assert m.system.initial_mode(xr) == loop.system.initial_mode(xr)
