@@ -69,14 +69,13 @@ class Symbolic:
 
 
 def _pade(order: int, T):
-    """Coefficients (ascending powers of s) of the [order/order] Pade approximant of exp(-s T)."""
-    n = order
-    c = [factorial(2 * n - k) * factorial(n) / (factorial(2 * n) * factorial(k) * factorial(n - k))
-         for k in range(n + 1)]
+    """Coefficients (ascending powers of s) of the [order/order] Pade approximant of exp(-s T):
+    c_k (-s T)^k over c_k (s T)^k, c_k = (2n - k)! n! / ((2n)! k! (n - k)!), exact rationals."""
     import sympy as sp
-    num = [sp.Rational(c[k]).limit_denominator(10 ** 15) * (-T) ** k for k in range(n + 1)]
-    den = [sp.Rational(c[k]).limit_denominator(10 ** 15) * T ** k for k in range(n + 1)]
-    return num, den
+    n = order
+    c = [sp.Rational(factorial(2 * n - k) * factorial(n), factorial(2 * n) * factorial(k) * factorial(n - k))
+         for k in range(n + 1)]
+    return [c[k] * (-T) ** k for k in range(n + 1)], [c[k] * T ** k for k in range(n + 1)]
 
 
 def _block_coefficients(b: BlockSpec, psym: dict):
