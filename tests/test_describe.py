@@ -576,3 +576,20 @@ def test_servo_loop_description_with_cogging_and_asymmetric_friction():
                                        rtol=1e-12, atol=1e-12)
         xr = x * [1, 0, 1]
         assert m.system.initial_mode(xr) == loop.system.initial_mode(xr)
+
+
+def test_belt_flow_sensitivities_across_stick_and_slip():
+    """Monodromy-type Jacobians of the described belt (saltation at stick entry and break-away)
+    and the parameter sensitivity by name, against central differences of the flow map."""
+    from hunting.continuation import flow
+    from hunting.continuation.flow import fd_jacobian
+    m = hunting.load_model(EXAMPLES / "belt.json")
+    x0 = np.array([0.1, -0.05])
+    kw = dict(rtol=1e-12, atol=1e-14)
+    f = flow(m.system, x0, 9.0, param_direction=m.param_direction("k"), **kw)
+    assert list(f.modes) == [1, 2, 1, 2, 1]                   # slip-, stick, slip-, stick, slip-
+    np.testing.assert_allclose(f.Phi, fd_jacobian(m.system, x0, 9.0, **kw), atol=2e-8)
+    h = 1e-6
+    xp = flow(m.with_params(k=2 + h).system, x0, 9.0, sensitivity=False, **kw).x
+    xm = flow(m.with_params(k=2 - h).system, x0, 9.0, sensitivity=False, **kw).x
+    np.testing.assert_allclose(f.dx_dmu, (xp - xm) / (2 * h), atol=1e-7)
