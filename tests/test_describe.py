@@ -593,3 +593,17 @@ def test_belt_flow_sensitivities_across_stick_and_slip():
     xp = flow(m.with_params(k=2 + h).system, x0, 9.0, sensitivity=False, **kw).x
     xm = flow(m.with_params(k=2 - h).system, x0, 9.0, sensitivity=False, **kw).x
     np.testing.assert_allclose(f.dx_dmu, (xp - xm) / (2 * h), atol=1e-7)
+
+
+def test_abs_of_a_contact_velocity_in_the_equations_takes_the_mode_side():
+    """A LuGre observer (a copy of the bristle equation driven by v) written with abs(v): the
+    mode's side replaces abs(w) in the equations too, so the generated field has no kink inside
+    a mode and the observer follows the true z to rounding."""
+    d = json.loads((EXAMPLES / "pid_lugre.json").read_text())
+    d["states"].append("zh")
+    d["equations"]["zh"] = "v - sigma0*abs(v)*zh/(Fc + (Fs - Fc)*exp(-(v/vs)**2))"
+    m = hunting.model(d)
+    vf_source = m.cache_path.read_text().split("def vf")[1].split("def guards")[0]
+    assert "abs(" not in vf_source
+    tr = hunting.simulate(m.system, m.state(), (0, 4), method="radau", rtol=1e-10, atol=1e-13)
+    assert tr.success and np.abs(tr.x[:, 3] - tr.x[:, 4]).max() < 1e-18

@@ -311,6 +311,16 @@ def build(spec: Spec) -> Symbolic:
                 zrates[c.state] = zdot
         # the laws may use signals, which never use forces: one substitution pass suffices
         f = [e.subs(subs) for e in raw]
+        # abs(w) and sign(w) of a slipping contact's velocity anywhere in the equations (an
+        # observer copying the bristle model, say) take the mode's side too: no kink inside a mode
+        kinks = {}
+        for ci, c in enumerate(contacts):
+            if not (c.model == "switch" and pt[ci] == STICK):
+                sgn = 1 if pt[ci] == SLIP_POS else -1
+                kinks[sp.Abs(w[ci])] = sgn * w[ci]
+                kinks[sp.sign(w[ci])] = sp.Integer(sgn)
+        if kinks:
+            f = [e.xreplace(kinks) for e in f]
         for name, zd in zrates.items():
             f[bristle_index[name]] = zd
         sticking = [ci for ci, c in enumerate(contacts) if c.model == "switch" and pt[ci] == STICK]
