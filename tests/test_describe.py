@@ -290,9 +290,15 @@ def test_belt_against_solve_ivp_with_stick_events():
 
 def test_pid_lugre_loop_against_solve_ivp():
     """Canudas de Wit et al. (1995): PID (kp 3, kv 6, ki 4) on a unit mass with LuGre friction
-    hunts around x_d = 1; scipy's Radau with restarts at v = 0 (the kink of |v|)."""
+    hunts around x_d = 1; scipy's Radau with restarts at v = 0 (the kink of |v|). The model
+    carries a LuGre observer zh written with abs(v): abs of a contact velocity takes the mode's
+    side in the equations too, so the field has no kink inside a mode and zh follows z."""
     from scipy.integrate import solve_ivp
-    m = hunting.load_model(EXAMPLES / "pid_lugre.json")
+    d = json.loads((EXAMPLES / "pid_lugre.json").read_text())
+    d["states"].append("zh")
+    d["equations"]["zh"] = "v - sigma0*abs(v)*zh/(Fc + (Fs - Fc)*exp(-(v/vs)**2))"
+    m = hunting.model(d)
+    assert "abs(" not in m.cache_path.read_text().split("def vf")[1].split("def guards")[0]
     p = dict(zip(m.param_names, m.params))
 
     def f(t, y):
@@ -321,6 +327,7 @@ def test_pid_lugre_loop_against_solve_ivp():
     tr = hunting.simulate(m.system, m.state(), (0, T), method="radau", rtol=1e-10, atol=1e-13, t_eval=te)
     X = np.array([ref[s] for s in te])
     assert np.abs(tr.x[:, :3] - X[:, :3]).max() < 1e-8 and np.abs(tr.x[:, 3] - X[:, 3]).max() < 1e-12
+    assert np.abs(tr.x[:, 4] - tr.x[:, 3]).max() < 1e-18
     assert tr.x[:, 0].max() > 1.4 and len(tr.events) >= 3          # it hunts: overshoot and reversals
 
 
@@ -594,16 +601,3 @@ def test_belt_flow_sensitivities_across_stick_and_slip():
     xm = flow(m.with_params(k=2 - h).system, x0, 9.0, sensitivity=False, **kw).x
     np.testing.assert_allclose(f.dx_dmu, (xp - xm) / (2 * h), atol=1e-7)
 
-
-def test_abs_of_a_contact_velocity_in_the_equations_takes_the_mode_side():
-    """A LuGre observer (a copy of the bristle equation driven by v) written with abs(v): the
-    mode's side replaces abs(w) in the equations too, so the generated field has no kink inside
-    a mode and the observer follows the true z to rounding."""
-    d = json.loads((EXAMPLES / "pid_lugre.json").read_text())
-    d["states"].append("zh")
-    d["equations"]["zh"] = "v - sigma0*abs(v)*zh/(Fc + (Fs - Fc)*exp(-(v/vs)**2))"
-    m = hunting.model(d)
-    vf_source = m.cache_path.read_text().split("def vf")[1].split("def guards")[0]
-    assert "abs(" not in vf_source
-    tr = hunting.simulate(m.system, m.state(), (0, 4), method="radau", rtol=1e-10, atol=1e-13)
-    assert tr.success and np.abs(tr.x[:, 3] - tr.x[:, 4]).max() < 1e-18

@@ -370,7 +370,8 @@ def build(spec: Spec) -> Symbolic:
                 wd[ci] = sp.diff(w[ci], t) + sum((sp.diff(w[ci], x[j]) * f[j] for j in range(len(x))), sp.Integer(0))
         wdot.append(wd)
         allsubs = {**subs, **fs}
-        signals.append([e.subs(allsubs) for e in sig_raw] + [F[c.force].subs(allsubs) for c in contacts])
+        signals.append([e.subs(allsubs).xreplace(kinks) for e in sig_raw]
+                       + [F[c.force].subs(allsubs).xreplace(kinks) for c in contacts])
         fv = sp.Matrix(f)
         jac.append(fv.jacobian(X).applyfunc(_clean))
         pjac.append(fv.jacobian(P).applyfunc(_clean) if p else sp.zeros(len(x), 0))
