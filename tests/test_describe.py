@@ -601,3 +601,11 @@ def test_belt_flow_sensitivities_across_stick_and_slip():
     xm = flow(m.with_params(k=2 - h).system, x0, 9.0, sensitivity=False, **kw).x
     np.testing.assert_allclose(f.dx_dmu, (xp - xm) / (2 * h), atol=1e-7)
 
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.yaml")),
+                         ids=lambda p: p.name)
+def test_example_files_load_and_run(path):
+    m = hunting.load_model(path)
+    tr = hunting.simulate(m.system, m.state(), (0.0, 0.5), method="radau", rtol=1e-8, atol=1e-12)
+    assert tr.success and m.description["name"] == m.name
