@@ -38,6 +38,7 @@ def test_api_names_layout_and_state():
     assert m2.system.param("k") == 3.0 and m.system.param("k") == 2.0
     assert m2.system.vector_field is m.system.vector_field          # nothing recompiled
     assert m2.description["parameters"]["k"] == 3.0
+    assert "contact friction (switch): force F, w = v - vb" in m.summary() and "k                = 2" in m.summary()
 
 
 @pytest.mark.parametrize("name, x0, method", [("table9.1", [0.1, 0.0, 0.0], "dop853"),

@@ -260,6 +260,26 @@ class CompiledModel:
         self._module.pjac(self._mode(x, t, mode), float(t), x, self.system.params, J)
         return J
 
+    def summary(self) -> str:
+        """Text listing of the model: states, parameters with values, signals, contacts, modes
+        (for command-line listings)."""
+        d = self._spec.description
+        lines = [f"{self.name}: {self.n_states} states, {len(self.mode_names)} modes"]
+        lines.append("  states: " + ", ".join(self.state_names))
+        lines += [f"  {k:<16} = {v:<14.6g} parameter" for k, v in zip(self.param_names, self.params)]
+        lines += [f"  {k:<16} = {v}" for k, v in d["signals"].items()]
+        lines += [f"  d{k}/dt = {v}" for k, v in d["equations"].items()]
+        for c, cd in zip(self.contacts, d["friction"]):
+            law = (f"slip {cd['slip']}, stick [-({cd['stick'][0]}), {cd['stick'][1]}]" if c.model == "switch"
+                   else f"level {cd['level']}, sigma0 {cd['sigma0']}, sigma1 {cd['sigma1']}, viscous {cd['viscous']}")
+            lines.append(f"  contact {c.name} ({c.model}): force {c.force}, w = {c.velocity}; {law}")
+        for b in d["blocks"]:
+            what = b.get("tf") or (f"delay {b['delay']} (Pade {b['order']})" if "delay" in b
+                                   else f"num {b['num']} / den {b['den']}")
+            lines.append(f"  block {b['output']} = [{what}] ({b['input']})")
+        lines.append("  modes: " + ", ".join(f"{i} {n}" for i, n in enumerate(self.mode_names)))
+        return "\n".join(lines)
+
     def __repr__(self) -> str:
         return (f"CompiledModel({self.name!r}, states={list(self.state_names)}, "
                 f"params={dict(zip(self.param_names, self.params.tolist()))}, modes={list(self.mode_names)})")
