@@ -5,6 +5,7 @@ systems with friction, after R. Hensen, "Controlled Mechanical Systems with Fric
 """
 from .errors import ConvergenceError, HuntingError, Status, SystemDefinitionError
 from .integrate import simulate
+from .continuation import find_cycle, follow
 from .models import (PID, Cogging, Coulomb, DirectionalCurve, Discontinuous, LuGre, Plant, ServoLoop,
                      StribeckCurve, Switch, Viscous, preset)
 from .results import EventLog, Trajectory
@@ -12,7 +13,7 @@ from .system import GUARD_SIG, JAC_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, Piece
 
 __version__ = "0.1.0"
 
-__all__ = ["ConvergenceError", "HuntingError", "Status", "SystemDefinitionError", "simulate", "PID",
+__all__ = ["ConvergenceError", "HuntingError", "Status", "SystemDefinitionError", "simulate", "find_cycle", "follow", "PID",
            "Cogging", "Coulomb", "DirectionalCurve", "Discontinuous", "LuGre", "Plant", "ServoLoop",
            "StribeckCurve", "Switch", "Viscous", "preset", "EventLog", "Trajectory", "GUARD_SIG",
            "JAC_SIG", "MODE_SIG", "RESET_SIG", "VF_SIG", "Mode", "PiecewiseSystem", "__version__"]

@@ -105,7 +105,7 @@ def _cmd_continue(args) -> int:
     sets = _parse_sets(args.set)
     if args.param in sets:
         raise HuntingError(f"--param {args.param} is also given in --set: remove it there")
-    br = follow(args.preset, args.param, args.start, args.end, overrides=sets,
+    br = follow(args.preset, args.param, args.start, args.end, params=sets,
                 stop_at=args.back_to if args.back_to is not None else args.start)
     print(f"{len(br.mu)} points, {br.message}")
     for s in br.special:
