@@ -180,10 +180,25 @@ def one_period(system: PiecewiseSystem, x0, T: float, mode0: int | None = None, 
 
 
 def _extremes(tr) -> tuple[np.ndarray, np.ndarray]:
+    """(min, max) per state over a sampled period: the samples, both sides of every event, and
+    a parabola through each interior extreme sample and its neighbours (the sampling error
+    O(dt^2) becomes O(dt^3) there)."""
     x = tr.x
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    t = tr.t
+    for i in range(x.shape[1]):
+        for k, better in ((int(np.argmin(x[:, i])), min), (int(np.argmax(x[:, i])), max)):
+            if 0 < k < len(t) - 1 and t[k - 1] < t[k] < t[k + 1] and tr.mode[k - 1] == tr.mode[k] == tr.mode[k + 1]:
+                c = np.polyfit(t[k - 1:k + 2] - t[k], x[k - 1:k + 2, i], 2)
+                if c[0] != 0:
+                    tv = -c[1] / (2 * c[0])
+                    if t[k - 1] - t[k] < tv < t[k + 1] - t[k]:
+                        v = float(np.polyval(c, tv))
+                        lo[i], hi[i] = (better(lo[i], v), hi[i]) if better is min else (lo[i], better(hi[i], v))
     if len(tr.events):
-        x = np.vstack([x, tr.events.x_before, tr.events.x_after])
-    return x.min(axis=0), x.max(axis=0)
+        ev = np.vstack([tr.events.x_before, tr.events.x_after])
+        lo, hi = np.minimum(lo, ev.min(axis=0)), np.maximum(hi, ev.max(axis=0))
+    return lo, hi
 
 
 def _described(target: Target, status, message, period, x0, lam, trivial_error, tr, event_times, modes,
@@ -292,14 +307,16 @@ def search_grid(D: float, n: int = 801, n_log: int = 121) -> np.ndarray:
 
 @dataclass(frozen=True)
 class MapStart:
-    """What the event-map start found: orbit (None when shooting failed), how (text), hint (a
-    state at the cycle's stick error for a transient, or None), fixed_point, twin."""
+    """What the event-map start found: orbit (None when not shot or shooting failed), how
+    (text), hint (a state near the cycle to start a transient from, or None), fixed_point,
+    twin, period (the Switch cycle's period, a guess)."""
 
     orbit: PeriodicOrbit | None
     how: str
     hint: np.ndarray | None = None
     fixed_point: object = None
     twin: object = None
+    period: float | None = None
 
 
 def event_map_start(target: Target, which: str = "stable", d_max: float | None = None,
@@ -332,15 +349,19 @@ def event_map_start(target: Target, which: str = "stable", d_max: float | None =
     f = max(cand, key=lambda c: c.d) if which == "stable" else min(cand, key=lambda c: c.d)
     x0, T = guess_from_stick_error(twin, f.d)
     loop = target.loop
+    how = f"event map of the Switch twin (stick error d = {f.d:.8g} on [0, {D:.6g}])"
     if loop.n_states == 4:
+        # LuGre: the Switch cycle's slip state with the bristles at their steady state starts a
+        # transient (the LuGre cycle's stick phases creep, so shooting straight from the Switch
+        # guess often drifts to the equilibrium set)
         c = loop.friction.curve.positive
         g = float(c.level(x0[1])) if x0[1] != 0 else c.Fs
-        x0 = np.append(x0, g / loop.friction.sigma0)
+        return MapStart(None, how, np.append(x0, g / loop.friction.sigma0), f, twin, T)
     po = shoot(target.system, x0, T, options=shooting)
-    how = f"event map of the Switch twin (stick error d = {f.d:.8g} on [0, {D:.6g}]), then shooting"
+    how += ", then shooting"
     if po.success:
-        return MapStart(po, how, None, f, twin)
-    return MapStart(None, f"{how} failed: {po.message}", loop.state(x1=f.d), f, twin)
+        return MapStart(po, how, None, f, twin, T)
+    return MapStart(None, f"{how} failed: {po.message}", x0, f, twin, T)
 
 
 def _default_start(target: Target) -> np.ndarray:
@@ -362,6 +383,36 @@ def _section_at(system: PiecewiseSystem, x: np.ndarray) -> int:
     f = system.evaluate(x)
     scale = np.maximum(np.abs(x), 1e-3 * max(float(np.max(np.abs(x))), 1e-300))
     return int(np.argmax(np.abs(f) / scale))
+
+
+def _transient(target: Target, xs, period_guess, start: StartOptions | None, shooting: ShootingOptions | None,
+               throw: bool = False) -> CycleResult:
+    """The transient from xs until the return map settles, shooting from its returns."""
+    sys_ = target.system
+    tried = []
+    sopt = shooting or ShootingOptions()
+    early = replace(sopt, max_iter=min(sopt.max_iter, 12))
+
+    def try_shoot(x, T, s, c, mismatch, settled):
+        po = shoot(sys_, x, T, section=s, options=sopt if settled else early)
+        tried.append(po)
+        return po.success and (po.stable or settled)
+
+    st = settle(sys_, xs, period_guess=period_guess, options=start, on_candidate=try_shoot)
+    if st.status == OrbitStatus.SUCCESS:
+        how = (f"transient simulation to t = {st.t_end:.6g} (returns to {sys_.state_names[st.section]} = "
+               f"{st.level:.6g} agree to {st.mismatch:.1e}), then shooting")
+        return _result(target, tried[-1], how)
+    if tried and st.status == OrbitStatus.NO_RECURRENCE:
+        last = tried[-1]
+        status = last.status if not last.success else OrbitStatus.NO_RECURRENCE
+        msg = (f"{st.message}; shooting from the returns gave {last.status.name}: {last.message}" if not last.success
+               else f"{st.message}; shooting from a return converged to an unstable cycle only")
+    else:
+        status, msg = st.status, st.message
+        if tried and not tried[-1].success:
+            msg += f"; shooting from the returns gave {tried[-1].status.name}: {tried[-1].message}"
+    return _failure(target, status, f"{msg}. {status.advice}", throw)
 
 
 # ------------------------------------------------------------------ the front end
@@ -406,13 +457,13 @@ def find_cycle(system, x0=None, period_guess: float | None = None, params: dict 
     >>> from hunting import find_cycle
     >>> res = find_cycle("table8.1-lugre", {"x1": -1.0}, params={"K": 0.04})
     >>> res.status.name, round(res.period, 3), res.stable
-    ('SUCCESS', 10.282, True)
+    ('SUCCESS', 10.379, True)
     >>> round(res.maximum["x1"], 4)
     0.0495
 
     A start inside the stick set stays there:
 
-    >>> find_cycle("table9.1", {"x3": 0.1}).status.name
+    >>> find_cycle("table9.1", {"x3": 0.01}).status.name
     'EQUILIBRIUM'
     """
     if which not in ("stable", "unstable"):
@@ -433,6 +484,22 @@ def find_cycle(system, x0=None, period_guess: float | None = None, params: dict 
             return _result_from_map(target, ms.twin, ms.fixed_point, ms.how)
         hint = ms.hint
         notes.append(ms.how)
+        if which == "unstable":
+            # a transient never settles on an unstable cycle: shoot from the map's guess or stop
+            if hint is None:
+                return _failure(target, OrbitStatus.NO_CYCLE, f"{ms.how}. {OrbitStatus.NO_CYCLE.advice}", throw)
+            po = shoot(sys_, hint, ms.period, options=shooting)
+            if po.success and not po.stable:
+                return _result(target, po, f"{ms.how}, then shooting")
+            why = po.message if not po.success else "shooting converged on a stable cycle"
+            return _failure(target, po.status if not po.success else OrbitStatus.NOT_CONVERGED,
+                            f"{ms.how}, then shooting: {why}", throw)
+        if hint is not None and ms.period:
+            # a transient from the cycle's neighbourhood, chunks scaled by the Switch period
+            st_res = _transient(target, hint, ms.period, start, shooting)
+            if st_res.success:
+                return replace(st_res, start=f"{ms.how}, then a {st_res.start}")
+            notes.append(f"a transient from there: {st_res.status.name}")
     xs = target.state(x0) if x0 is not None else (hint if hint is not None else _default_start(target))
     if period_guess is not None:
         s = _section_at(sys_, xs)
@@ -441,32 +508,11 @@ def find_cycle(system, x0=None, period_guess: float | None = None, params: dict 
         if po.success:
             return _result(target, po, how)
         notes.append(f"{how} failed: {po.message}")
-    tried = []
-
-    sopt = shooting or ShootingOptions()
-    early = replace(sopt, max_iter=min(sopt.max_iter, 12))
-
-    def try_shoot(x, T, s, c, mismatch, settled):
-        po = shoot(sys_, x, T, section=s, options=sopt if settled else early)
-        tried.append(po)
-        return po.success and (po.stable or settled)
-
-    st = settle(sys_, xs, period_guess=period_guess, options=start, on_candidate=try_shoot)
-    if st.status == OrbitStatus.SUCCESS:
-        po = tried[-1]
-        how = (f"transient simulation to t = {st.t_end:.6g} (returns to {sys_.state_names[st.section]} = "
-               f"{st.level:.6g} agree to {st.mismatch:.1e}), then shooting")
-        return _result(target, po, how)
-    if tried and st.status == OrbitStatus.NO_RECURRENCE:
-        last = tried[-1]
-        status = last.status if not last.success else OrbitStatus.NO_RECURRENCE
-        msg = (f"{st.message}; shooting from the returns gave {last.status.name}: {last.message}" if not last.success
-               else f"{st.message}; shooting from a return converged to an unstable cycle only")
-    else:
-        status, msg = st.status, st.message
-        if tried and not tried[-1].success:
-            msg += f"; shooting from the returns gave {tried[-1].status.name}: {tried[-1].message}"
-    msg = f"{msg}. {status.advice}"
+    res = _transient(target, xs, period_guess, start, shooting)
+    if res.success:
+        return res
     if notes:
-        msg = "; ".join(notes) + "; then " + msg
-    return _failure(target, status, msg, throw)
+        res = replace(res, message="; ".join(notes) + "; then " + res.message)
+    if throw:
+        raise ConvergenceError(f"{target.label}: no cycle ({res.status.name}): {res.message}", res)
+    return res

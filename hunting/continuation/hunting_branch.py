@@ -99,5 +99,5 @@ def follow(system, param: str, start: float, end: float, *, params: dict | None 
     br = continue_orbit(lens.system_at, orbit, start, end, param=param, options=opt, shooting=shooting,
                         stop_at_mu=start if stop_at is None else stop_at,
                         amplitude=servo_amplitude if exact_servo else None,
-                        param_direction=(lambda mu, d=lens.direction(start): d) if lens.affine else lens.direction)
+                        param_direction=lens.direction)
     return replace(br, label=label)

@@ -169,7 +169,10 @@ def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
             break
         A = np.column_stack([(fl.Phi - np.eye(n))[:, free], fl.f])
         try:
-            if np.linalg.cond(A) > 1e14:
+            # singular in the scaled unknowns (states of very different sizes, e.g. the LuGre
+            # bristle state, must not read as singular)
+            colscale = np.append(scale[free], scale[n])
+            if np.linalg.cond(A * colscale[None, :] / scale[:n, None]) > 1e14:
                 raise np.linalg.LinAlgError
             dz = np.linalg.solve(A, -r)
         except np.linalg.LinAlgError:

@@ -31,6 +31,7 @@ class OrbitStatus(enum.IntEnum):
     POINT_LIMIT = 107         #: continuation stopped at max_points
     STEP_LIMIT = 108          #: continuation's corrector failed down to the smallest step
     NO_START = 109            #: no starting cycle for continuation
+    NO_CYCLE = 110            #: the event map has no cycle of the kind asked for
 
     @property
     def ok(self) -> bool:
@@ -50,9 +51,9 @@ _ADVICE = {
                               "start with a larger deviation (x0) or change the parameters"),
     OrbitStatus.ESCAPE: ("the state grew without bound: the loop is unstable at these parameters "
                          "(no bounded cycle from this start)"),
-    OrbitStatus.SINGULAR_JACOBIAN: ("the shooting Jacobian is singular: the orbit may graze a switching "
-                                    "surface or the section may be tangent to the flow; start from another "
-                                    "point of the orbit"),
+    OrbitStatus.SINGULAR_JACOBIAN: ("the shooting Jacobian is singular: the orbit is not isolated (a family "
+                                    "of cycles, e.g. a conserved quantity), grazes a switching surface, or the "
+                                    "section is tangent to the flow; start from another point of the orbit"),
     OrbitStatus.NOT_CONVERGED: ("Newton did not converge: improve the guess (x0, period_guess) or loosen tol"),
     OrbitStatus.INTEGRATION_FAILED: ("an integration failed (see the integrator's status in the message): "
                                      "adjust the integration options or the parameters"),
@@ -60,4 +61,6 @@ _ADVICE = {
     OrbitStatus.STEP_LIMIT: ("the corrector failed down to the smallest step: a sharp turn, a grazing point or "
                              "the end of the branch; lower ds_min or restart past this point"),
     OrbitStatus.NO_START: "no starting cycle was found at the first parameter value",
+    OrbitStatus.NO_CYCLE: ("the event map has no cycle of this kind on the searched range: widen it (d_max), "
+                           "or change the parameters"),
 }

@@ -45,7 +45,9 @@ class ParameterLens:
     params_at : callable float -> ndarray
         The flat parameter array at mu.
     affine : bool
-        True when the array is affine in mu (then ``direction`` is exact and constant).
+        True when the array is affine in mu.
+    slope : ndarray or None
+        d params / d mu when affine (then ``direction`` returns it: exact and constant).
 
     Examples
     --------
@@ -62,13 +64,16 @@ class ParameterLens:
     base: PiecewiseSystem
     params_at: Callable[[float], np.ndarray] = field(repr=False)
     affine: bool = False
+    slope: np.ndarray | None = field(default=None, repr=False)
 
     def system_at(self, mu: float) -> PiecewiseSystem:
         """The system with this parameter at ``mu`` (no recompilation)."""
         return self.base.with_param_array(self.params_at(float(mu)))
 
     def direction(self, mu: float, rel: float = 1e-8) -> np.ndarray:
-        """d params / d mu at mu (central differences; exact when ``affine``)."""
+        """d params / d mu at mu (the exact slope when ``affine``, else central differences)."""
+        if self.slope is not None:
+            return self.slope.copy()
         h = rel * max(abs(mu), 1e-3)
         return (self.params_at(mu + h) - self.params_at(mu - h)) / (2 * h)
 
@@ -91,7 +96,7 @@ def _affine_lens(name: str, value: float, base: PiecewiseSystem, build: Callable
             if not np.any(slope):
                 raise SystemDefinitionError(f"parameter {name!r} does not change the system at {value!r} "
                                             f"(is it used by this model?)")
-            return ParameterLens(name, value, base, lambda mu: p0 + (mu - value) * slope, True)
+            return ParameterLens(name, value, base, lambda mu: p0 + (mu - value) * slope, True, slope)
     return ParameterLens(name, value, base, lambda mu: np.asarray(build(mu), dtype=float), False)
 
 
@@ -182,7 +187,9 @@ class Target:
             p = p0.copy()
             p[i] = mu
             return p
-        return ParameterLens(name, value, self.system, at, True)
+        slope = np.zeros_like(p0)
+        slope[i] = 1.0
+        return ParameterLens(name, value, self.system, at, True, slope)
 
 
 def _is_model(obj) -> bool:
