@@ -122,7 +122,7 @@ class Target:
 
     def state(self, x0=None) -> np.ndarray:
         """A full state vector from None (zeros), a mapping state name -> value (unnamed states
-        start at 0) or an array of all states.
+        start at 0, or at a compiled model's initial values) or an array of all states.
 
         Examples
         --------
@@ -131,10 +131,11 @@ class Target:
         [-0.2, 0.0, 0.0]
         """
         n = self.system.n_states
+        defaults = getattr(self.source, "state", None) if _is_model(self.source) else None
         if x0 is None:
-            return np.zeros(n)
+            return np.asarray(defaults(), dtype=float) if defaults else np.zeros(n)
         if isinstance(x0, Mapping):
-            x = np.zeros(n)
+            x = np.asarray(defaults(), dtype=float).copy() if defaults else np.zeros(n)
             for k, v in x0.items():
                 if k not in self.state_names:
                     raise SystemDefinitionError(f"x0 names {k!r}, which is not a state of {self.label}: "
@@ -171,14 +172,8 @@ class Target:
             value = values.get(key, values.get(key[:-4], 0.0) if key.endswith("_neg") else 0.0)
             return _affine_lens(name, float(value), self.system,
                                 lambda mu: build_preset(pname, **{**overrides, name: mu}).param_array())
-        src = self.source
-        if _is_model(src):
-            names = tuple(_model_param_names(src))
-            if name not in names:
-                raise SystemDefinitionError(f"parameter {name!r} is not a parameter of {self.label}: "
-                                            f"parameters are {list(names)}")
-            value = float(_model_param_value(src, name))
-            return _affine_lens(name, value, self.system, lambda mu: src.with_params(**{name: mu}).system.params)
+        # a PiecewiseSystem, or a compiled model: its system's parameter names are the model's
+        # layout, one slot per name
         value = self.system.param(name)          # raises naming the parameters when unknown
         i = self.system.param_names.index(name)
         p0 = self.system.params.copy()
@@ -196,18 +191,6 @@ def _is_model(obj) -> bool:
     """A compiled model (hunting.model(...)): has a PiecewiseSystem ``.system`` and ``with_params``."""
     return (not isinstance(obj, PiecewiseSystem) and isinstance(getattr(obj, "system", None), PiecewiseSystem)
             and callable(getattr(obj, "with_params", None)))
-
-
-def _model_param_names(model) -> tuple:
-    names = getattr(model, "param_names", None)
-    return tuple(names) if names is not None else model.system.param_names
-
-
-def _model_param_value(model, name: str) -> float:
-    params = getattr(model, "params", None)
-    if isinstance(params, Mapping) and name in params:
-        return float(params[name])
-    return model.system.param(name)
 
 
 def _contacts_of(system: PiecewiseSystem, source) -> tuple:
