@@ -268,3 +268,47 @@ def test_grid_is_linspace(a, width, n):
     if not a + width > a:
         return
     assert np.array_equal(B.grid(text), np.linspace(a, a + width, n))
+
+
+# ---------------------------------------------------------------- status, not success
+def test_unstable_gains_end_with_diverged_not_success():
+    lp = hunting.preset("table9.1", P=-5)
+    tr = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0))
+    assert tr.status == hunting.Status.DIVERGED and not tr.success
+    assert 1e6 < np.max(np.abs(tr.x_final)) < 1e7 and tr.t_final < 5      # ends at the first point beyond
+    assert np.max(np.abs(tr.x[:-1])) <= 1e6 and "controller gains" in tr.message
+    free = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), growth=None)
+    assert free.status == hunting.Status.SUCCESS and np.max(np.abs(free.x_final)) > 1e70
+    sparse = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), t_eval=np.linspace(0, 30, 7))
+    assert sparse.status == hunting.Status.DIVERGED and sparse.t[-1] == 5.0
+    with pytest.raises(hunting.ConvergenceError, match="DIVERGED|grew by orders of magnitude"):
+        hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), throw=True)
+
+
+def test_bounds_end_the_run_at_the_first_point_beyond_them():
+    lp = hunting.preset("table9.1")
+    tr = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), bounds=[0.2, np.inf, np.inf])
+    assert tr.status == hunting.Status.OUT_OF_BOUNDS and "x1" in tr.message
+    assert abs(tr.x[-1, 0]) > 0.2 and np.all(np.abs(tr.x[:-1, 0]) <= 0.2)
+    assert tr.events.t.size == 0 or tr.events.t[-1] <= tr.t_final
+    full = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0))
+    assert full.success and np.allclose(full.x[: tr.x.shape[0] - 1], tr.x[:-1])
+
+
+def test_simulate_names_a_bad_x0_and_bad_limits():
+    sy = hunting.preset("table9.1").system
+    for x0 in ("abc", [1, "a", 2], {"a": 1}):
+        with pytest.raises(hunting.SystemDefinitionError, match=r"x0 = .* is not allowed: x0 must be 3 finite numbers"):
+            hunting.simulate(sy, x0, (0, 1))
+    for kw, text in ((dict(growth=0.5), "growth = 0.5"), (dict(bounds=-1), "bounds = -1"),
+                     (dict(bounds=[1, 2]), "bounds = \\[1, 2\\]")):
+        with pytest.raises(hunting.SystemDefinitionError, match=text):
+            hunting.simulate(sy, [0.1, 0, 0], (0, 1), **kw)
+
+
+def test_cli_warns_up_front_and_exits_1_on_divergence(capsys):
+    code, out, err = run_main(capsys, ["simulate", "table9.1", "--set", "P=-5", "--x0", "0.1,0,0"])
+    assert code == 1 and out.startswith("DIVERGED") and "SUCCESS" not in out
+    assert "warning: the linear loop without friction is unstable" in err
+    code, out, err = run_main(capsys, ["simulate", "table9.1", "--x0", "0.1,0,0", "--t", "2"])
+    assert code == 0 and "warning" not in err

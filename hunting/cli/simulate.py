@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .boundary import Output, positive_float, state_spec
+from .boundary import Output, UsageError, finite_float, positive_float, state_spec
 from .systems import add_system_arguments, resolve_system
 
 NAME = "simulate"
@@ -17,6 +17,9 @@ def add_arguments(p) -> None:
     p.add_argument("--t", type=positive_float, default=30.0, help="end time [s] (default 30)")
     p.add_argument("--method", default="dop853", choices=("dop853", "dp5", "radau"),
                    help="integration method (radau for stiff LuGre loops)")
+    p.add_argument("--growth", type=finite_float, default=1e6, metavar="FACTOR",
+                   help="end with status DIVERGED when some |x_i| exceeds FACTOR * max(|x0|, 1) "
+                        "(default 1e6; 0: no check)")
     p.add_argument("--json", metavar="FILE", help="trajectory and events as JSON ('-': standard output)")
     p.add_argument("--plot", metavar="FILE", help="time responses and phase portrait (png, pdf, svg, ...)")
 
@@ -31,7 +34,9 @@ def run(args, results) -> int:
     choice = resolve_system(args)
     loop = choice.loop
     x0 = args.x0.vector(list(loop.system.state_names)) if args.x0 else np.zeros(loop.n_states)
-    tr = simulate(loop.system, x0, (0.0, args.t), method=args.method)
+    if args.growth != 0 and args.growth <= 1:
+        raise UsageError(f"--growth {args.growth:g} is not allowed: a factor > 1, or 0 for no check")
+    tr = simulate(loop.system, x0, (0.0, args.t), method=args.method, growth=args.growth or None)
     print(tr.summary())
     print(f"events: {len(tr.events)}; final state {np.array2string(tr.x_final, precision=6)}")
     if args.json:
