@@ -249,7 +249,7 @@ def settle(system: PiecewiseSystem, x0, *, period_guess: float | None = None, op
             break
         span = min(L, t_max - t)
         tr = simulate(system, x, (0.0, span), method=opt.method, rtol=opt.rtol, atol=opt.atol, mode0=mode,
-                      max_events=opt.max_events, max_steps=opt.max_steps)
+                      max_events=opt.max_events, max_steps=opt.max_steps, growth=None)   # escape: checked below
         xs = tr.x
         finite = np.all(np.isfinite(xs))
         if not finite or tr.status.name == "NON_FINITE":
