@@ -149,3 +149,21 @@ def family_system():
     return PiecewiseSystem(name="family", state_names=("x", "y", "z"), modes=("smooth",), guard_names=("none",),
                            param_names=(), params=np.zeros(1), vector_field=family_vf, guards=family_guards,
                            transition=family_reset, mode_of=family_mode)
+
+
+# ---------------------------------------------------------------- the same as descriptions
+BELT_DESCRIPTION = {
+    "name": "belt", "parameters": dict(BELT), "states": ["q", "v"], "signals": {"u": "-k*q"},
+    "equations": {"q": "v", "v": "(u - F)/m"},
+    "friction": {"force": "F", "velocity": "v - vb", "model": "switch",
+                 "slip": "sign(w)*(Fc + (Fs - Fc)*exp(-abs(w)/vs))", "stick": "Fs"}}
+
+# the PID + LuGre loop of Canudas de Wit et al. (1995), in the position q with set point qd
+PID_LUGRE_DESCRIPTION = {
+    "name": "pid-lugre",
+    "parameters": {"m": 1.0, "kp": 3.0, "kd": 6.0, "ki": 4.0, "qd": 1.0, "Fc": 1.0, "Fs": 1.5, "vs": 0.001,
+                   "sigma0": 1e5, "sigma1": 316.22776601683796, "sigma2": 0.4},
+    "states": ["q", "v", "ie"], "signals": {"e": "q - qd", "u": "-(kp*e + kd*v + ki*ie)"},
+    "equations": {"q": "v", "v": "(u - F)/m", "ie": "e"},
+    "friction": {"force": "F", "velocity": "v", "model": "lugre", "level": "Fc + (Fs - Fc)*exp(-(w/vs)**2)",
+                 "sigma0": "sigma0", "sigma1": "sigma1", "viscous": "sigma2*w"}}

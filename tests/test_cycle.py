@@ -9,7 +9,8 @@ import pytest
 import hunting
 from hunting import find_cycle, follow, preset, simulate
 from hunting.continuation import ContinuationOptions, OrbitStatus, StartOptions, resolve, shoot
-from cycle_systems import belt_reference_cycle, belt_system, family_system
+from cycle_systems import (BELT_DESCRIPTION, PID_LUGRE_DESCRIPTION, belt_reference_cycle, belt_system,
+                           family_system)
 
 
 def test_lugre_k004_cycle_from_the_event_map_and_from_the_regulator_task():
@@ -33,13 +34,15 @@ def test_lugre_k004_cycle_from_the_event_map_and_from_the_regulator_task():
     assert np.min(tr.x[late, 0]) == pytest.approx(a.minimum["x1"], rel=1e-5)
 
 
+@pytest.mark.parametrize("written", ["description", "by hand"])
 @pytest.mark.parametrize("start", [None, {"q": 2.0, "v": -1.0}, [-0.5, 0.3]])
-def test_belt_cycle_matches_solve_ivp(start):
-    """The moving-belt block of issue 19 (exponential law), written by hand as a user would:
-    period, stick and slip durations and extremes against scipy's solve_ivp with the stick
-    phase and its events written in the test (tests/cycle_systems.py)."""
+def test_belt_cycle_matches_solve_ivp(written, start):
+    """The moving-belt block of issue 19 (exponential law), as a model description and written
+    by hand as a user would: period, stick and slip durations and extremes against scipy's
+    solve_ivp with the stick phase and its events written in the test (tests/cycle_systems.py)."""
     ref = belt_reference_cycle()
-    r = find_cycle(belt_system(), start)
+    system = hunting.model(BELT_DESCRIPTION) if written == "description" else belt_system()
+    r = find_cycle(system, start)
     assert r.success and r.stable
     assert r.period == pytest.approx(ref["period"], rel=1e-9)
     assert [p.kind for p in r.phases] in (["slip", "stick"], ["stick", "slip"])
@@ -54,18 +57,22 @@ def test_belt_cycle_matches_solve_ivp(start):
 
 
 def test_pid_lugre_loop_closes_under_solve_ivp():
-    """The PID + LuGre loop of Canudas de Wit et al. (1995): sigma0 = 1e5, sigma1 = sqrt(1e5),
-    sigma2 = 0.4, Fc = 1, Fs = 1.5, vs = 1e-3, kp = 3, kd = 6, ki = 4, unit mass. The orbit found
-    is integrated over one period by scipy's Radau with the equations written here; it closes
-    and has the same extremes."""
+    """The PID + LuGre loop of Canudas de Wit et al. (1995) as a user's model description
+    (sigma0 = 1e5, sigma1 = sqrt(1e5), sigma2 = 0.4, Fc = 1, Fs = 1.5, vs = 1e-3, kp = 3, kd = 6,
+    ki = 4, unit mass, set point 1) from its default start (at rest at q = 0). The orbit found is
+    integrated over one period by scipy's Radau with the equations written here: it closes and
+    has the same extremes; the same loop as a preset (hand-written kernels, event-map start)
+    has the same period."""
     from scipy.integrate import solve_ivp
-    r = find_cycle("table4.1", params=dict(P=3.0, D=2.0, I=4.0 / 3.0, force_amplitude=0.0, q_d=1.0))
-    assert r.success and r.stable
+    r = find_cycle(hunting.model(PID_LUGRE_DESCRIPTION))
+    assert r.success and r.stable and "transient" in r.start
+    assert r.state_names == ("q", "v", "ie", "z")
     m, Fc, Fs, vs, s0, s1, s2 = 1.0, 1.0, 1.5, 1e-3, 1e5, math.sqrt(1e5), 0.4
-    kp, kd, ki = 3.0, 6.0, 4.0
+    kp, kd, ki, qd = 3.0, 6.0, 4.0, 1.0
 
     def rhs(t, y):
-        e, v, ie, z = y
+        q, v, ie, z = y
+        e = q - qd
         g = Fc + (Fs - Fc) * math.exp(-(v / vs) ** 2)
         zd = v - s0 * abs(v) * z / g
         return [v, (-(kp * e + kd * v + ki * ie) - (s0 * z + s1 * zd + s2 * v)) / m, e, zd]
@@ -78,6 +85,8 @@ def test_pid_lugre_loop_closes_under_solve_ivp():
     for i, k in enumerate(r.state_names):
         assert y[i].max() == pytest.approx(r.maximum[k], abs=1e-6 * size[i])
         assert y[i].min() == pytest.approx(r.minimum[k], abs=1e-6 * size[i])
+    same = find_cycle("table4.1", params=dict(P=3.0, D=2.0, I=4.0 / 3.0, force_amplitude=0.0, q_d=1.0))
+    assert same.period == pytest.approx(r.period, rel=1e-7)
 
 
 @pytest.mark.parametrize("overrides,d_star", [({}, 0.2523), ({"beta": 1}, 0.2314), ({"beta": 0.5}, 0.1786),

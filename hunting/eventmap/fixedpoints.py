@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import Status
 from ..models.loop import ServoLoop
 from .engine import EventMap, MapOptions, evaluate_map, event_map
+from .family import as_stick_map
 
 
 @dataclass(frozen=True)
@@ -172,6 +173,7 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
     Cycles are reported once per orbit (the largest stick error of the orbit as ``d``) with
     their minimal number of stick phases; the equilibrium set d = 0 is always reported when the
     grid spans or touches 0. ``thesis_fits`` adds the thesis' local fits for comparison."""
+    loop = as_stick_map(loop)            # a preset name, compiled model or PiecewiseSystem as well
     opt = options or MapOptions()
     grid = np.asarray(grid, dtype=float).ravel()
     em = emap if emap is not None else event_map(loop, grid, iterate, derivative=False, options=opt)
