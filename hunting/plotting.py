@@ -317,3 +317,80 @@ def plot_attractor_diagram(values, attractors_per_value, *, param: str = "K", ti
     ax.legend(fontsize=8, loc="best")
     _finish(fig, ax, own, title, path)
     return fig
+
+
+def plot_cycle(result, system, *, periods: int = 2, units: dict | None = None, title: str = "", path=None):
+    """A periodic orbit (a :class:`hunting.continuation.CycleResult`): each state over
+    ``periods`` periods from its x0 with the stick phases of every contact shaded, and a phase
+    portrait of one period with the stick segments drawn thick.
+
+    ``system`` is the PiecewiseSystem the result belongs to (at the result's parameters).
+    Returns the figure; saves it when ``path`` is given."""
+    from .integrate.simulate import simulate
+    plt = _plt()
+    units = units or {}
+    T = float(result.period)
+    names = list(result.state_names)
+    n = len(names)
+    tr = simulate(system, result.x0_array, (0.0, periods * T), mode0=result.mode0,
+                  t_eval=np.linspace(0.0, periods * T, 2000 * periods + 1), rtol=1e-10, atol=1e-13)
+    contacts = sorted({p.contact for p in result.phases})
+    colors = {c: col for c, col in zip(contacts, ("0.82", "#f2c98a", "#a9d3a5", "#c7b7e0"))}
+    fig = plt.figure(figsize=(11, 1.9 * max(n, 3) + 0.6))
+    gs = fig.add_gridspec(n, 2, width_ratios=[1.5, 1])
+    for i, name in enumerate(names):
+        ax = fig.add_subplot(gs[i, 0])
+        labelled = set()
+        for k in range(periods):
+            for p in result.phases:
+                if p.kind != "stick":
+                    continue
+                for a in (p.start + k * T, p.start + (k - 1) * T):      # a phase may wrap the period
+                    lo, hi = max(a, 0.0), min(a + p.duration, periods * T)
+                    if hi > lo:
+                        lab = None
+                        if i == 0 and p.contact not in labelled:
+                            lab = "stick" if len(contacts) == 1 else f"stick ({p.contact})"
+                            labelled.add(p.contact)
+                        ax.axvspan(lo, hi, color=colors[p.contact], lw=0, label=lab)
+        ax.plot(tr.t, tr.x[:, i], lw=1.0, color="C0")
+        for k in range(1, periods):
+            ax.axvline(k * T, color="0.4", lw=0.6, ls="--", label="period" if (i == 0 and k == 1) else None)
+        ax.set_ylabel(f"{name} [{units[name]}]" if name in units else name)
+        ax.set_xlim(0.0, periods * T)
+        ax.grid(alpha=0.3)
+        if i == 0:
+            ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+        if i == n - 1:
+            ax.set_xlabel("t from x0 [s]")
+    # phase portrait: the first two states among those that move most relative to their size
+    rng = np.array([result.maximum[k] - result.minimum[k] for k in names])
+    size = np.maximum(np.array([max(abs(result.maximum[k]), abs(result.minimum[k])) for k in names]), 1e-300)
+    rel = rng / size
+    big = [k for k in range(n) if rel[k] >= 0.5 * rel.max()] + [k for k in range(n) if rel[k] < 0.5 * rel.max()]
+    i, j = (big[0], big[1]) if n >= 2 else (0, 0)
+    ax = fig.add_subplot(gs[:, 1])
+    one = tr.t <= T
+    ax.plot(tr.x[one, i], tr.x[one, j], lw=1.0, color="C0", label="slip")
+    st = np.zeros(tr.t.size, dtype=bool)
+    for p in result.phases:
+        if p.kind == "stick":
+            rel_t = (tr.t - p.start) % T
+            st |= rel_t <= p.duration
+    if np.any(st & one):
+        ax.plot(np.where(st, tr.x[:, i], np.nan)[one], np.where(st, tr.x[:, j], np.nan)[one], lw=3.0,
+                color="C3", label="stick")
+    ax.plot([result.x0[names[i]]], [result.x0[names[j]]], "o", color="k", ms=5, label="x0")
+    ax.set_xlabel(f"{names[i]} [{units[names[i]]}]" if names[i] in units else names[i])
+    ax.set_ylabel(f"{names[j]} [{units[names[j]]}]" if names[j] in units else names[j])
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    lam = list(result.multipliers)
+    if lam:
+        lam.pop(int(np.argmin(np.abs(np.array(lam) - 1.0))))        # the trivial multiplier
+    fig.suptitle(title or f"{result.label}: {'stable' if result.stable else 'unstable'} cycle, period {T:.6g} s"
+                 + (f", largest |lambda| besides 1: {max(np.abs(lam)):.3g}" if lam else ""), fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        save(fig, path)
+    return fig

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..errors import SystemDefinitionError
 from .boundary import Output, UsageError, finite_float
-from .systems import add_system_arguments, resolve_system
+from .systems import add_system_arguments, resolve_system, system_inputs
 
 NAME = "continue"
 HELP = "follow the hunting branch in one parameter (shooting + arclength)"
@@ -11,7 +11,8 @@ HELP = "follow the hunting branch in one parameter (shooting + arclength)"
 
 def add_arguments(p) -> None:
     add_system_arguments(p)
-    p.add_argument("--param", required=True, help="the parameter to vary (a preset parameter, e.g. K or P)")
+    p.add_argument("--param", required=True, help="the parameter to vary (a preset parameter, e.g. K or P, or a "
+                   "model parameter)")
     p.add_argument("--from", dest="start", type=finite_float, required=True, metavar="A",
                    help="start value of the parameter")
     p.add_argument("--to", dest="end", type=finite_float, required=True, metavar="B",
@@ -23,7 +24,7 @@ def add_arguments(p) -> None:
 
 
 def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], []
+    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], system_inputs(args)
 
 
 def run(args, results) -> int:
@@ -39,7 +40,7 @@ def run(args, results) -> int:
         resolve_system(args, warn=False, **{args.param: args.end})
     except SystemDefinitionError as e:
         raise UsageError(f"--param {args.param} --from {args.start:g} --to {args.end:g}: {e}") from None
-    br = follow(choice.preset, args.param, args.start, args.end, params=choice.overrides,
+    br = follow(choice.source, args.param, args.start, args.end, params=choice.params,
                 stop_at=args.back_to if args.back_to is not None else args.start)
     print(f"{len(br.mu)} points, {br.message}")
     for s in br.special:
@@ -47,5 +48,5 @@ def run(args, results) -> int:
     if args.json:
         results.write_json(args.json, br.as_dict(), indent=1)
     if args.plot:
-        plot_branch(br, title=f"{choice.preset}: hunting branch in {args.param}", path=args.plot)
-    return 0
+        plot_branch(br, title=f"{choice.preset or choice.model.name}: hunting branch in {args.param}", path=args.plot)
+    return 0 if br.status.ok or len(br.mu) else 1

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from .boundary import Output, grid, positive_int
-from .systems import add_system_arguments, resolve_system
+from .systems import add_system_arguments, resolve_system, system_inputs
 
 NAME = "eventmap"
 HELP = "stick-to-stick event map and its fixed points"
@@ -19,16 +19,19 @@ def add_arguments(p) -> None:
 
 
 def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], []
+    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], system_inputs(args)
 
 
 def run(args, results) -> int:
     from ..errors import Status
-    from ..eventmap import event_map, fixed_points
+    from ..eventmap import event_map, fixed_points, stick_family
     from ..plotting import plot_event_map
     choice = resolve_system(args)
-    loop = choice.loop
-    loop.require_stick_map()
+    if choice.model is not None:
+        loop = stick_family(choice.model)   # one Switch contact whose stick states form a 1-parameter family
+    else:
+        loop = choice.loop
+        loop.require_stick_map()
     em = event_map(loop, args.grid, args.iterate, derivative=False)
     fps = fixed_points(loop, args.grid, args.iterate, emap=em)
     for f in fps:
@@ -36,7 +39,8 @@ def run(args, results) -> int:
               f"{'stable' if f.stable else 'unstable'}")
     if args.json:
         results.write_json(args.json, {
-            "preset": args.preset, "set": choice.overrides, "iterate": args.iterate,
+            "preset": args.preset, "model": getattr(args, "model", None), "set": choice.overrides,
+            "iterate": args.iterate,
             "warnings": list(choice.warnings), "grid": em.grid.tolist(),
             "image": [None if not ok else float(v) for v, ok in zip(em.image, em.ok)],
             "status": [Status(int(s)).name for s in em.status],

@@ -37,7 +37,9 @@ class Phase:
 
     kind : "stick" or "slip"; duration [time unit]; start : time from the orbit's x0 at which
     the phase begins (in [0, period)); contact : the contact's name; modes : names of the
-    system modes passed through."""
+    system modes passed through (for a LuGre contact's stick phase, which has no mode of its
+    own, the velocity bound that defines it: |w| below PRESLIDING_FRACTION of its largest value
+    over the orbit)."""
 
     kind: str
     duration: float
@@ -84,6 +86,9 @@ class CycleResult:
         The shooting result (monodromy, event times, mode sequence); continuation starts from it.
     start : str
         Which way in found it (event map, shooting from x0, transient).
+    mode0 : int or None
+        The mode at x0 when the system's ``mode_of`` would not give it (x0 on a switching
+        surface, e.g. a break-away state), else None.
     """
 
     status: OrbitStatus
@@ -100,6 +105,7 @@ class CycleResult:
     stable: bool = False
     orbit: PeriodicOrbit | None = field(default=None, repr=False)
     start: str = ""
+    mode0: int | None = None
 
     @property
     def success(self) -> bool:
@@ -142,9 +148,62 @@ class CycleResult:
 
 
 # ------------------------------------------------------------------ the orbit's description
-def phases_of(target: Target, period: float, event_times, modes) -> tuple:
+#: a contact without a stick mode (LuGre) sticks where |w| is below PRESLIDING_FRACTION of its
+#: largest value over the orbit (presliding: on the chapter-8 loop the creep in stick is 3e-5
+#: of the slip speed); a stretch above it counts as slip only when |w| reaches SLIP_FRACTION of
+#: the largest value there (the bristles' ringing after a stop reaches 1 %: it is not slip)
+PRESLIDING_FRACTION = 1e-3
+SLIP_FRACTION = 0.1
+
+
+def _pieces(segs, T) -> list:
+    """Merge segments (start, end, kind, label) into phases, join the two ends of a phase the
+    period starts inside, and start the list at the first phase that begins after x0."""
+    pieces = []          # [kind, start, end, labels]
+    for a, b, kind, name in segs:
+        if pieces and pieces[-1][0] == kind:
+            pieces[-1][2] = b
+            if pieces[-1][3][-1] != name:
+                pieces[-1][3].append(name)
+        else:
+            pieces.append([kind, a, b, [name]])
+    if len(pieces) > 1 and pieces[0][0] == pieces[-1][0]:
+        last = pieces.pop()
+        first = pieces[0]
+        pieces[0] = [first[0], last[1] - T, first[2], last[3] + [m for m in first[3] if m not in last[3]]]
+    start_idx = next((i for i, p in enumerate(pieces) if p[1] >= 0), 0)
+    return pieces[start_idx:] + pieces[:start_idx]
+
+
+def _presliding_segments(c, tr, T) -> list:
+    """(start, end, kind, label) of a contact without stick modes from |w| on a sampled period."""
+    w = np.abs(np.array([c.velocity(x, t) for t, x in zip(tr.t, tr.x)]))
+    thr = PRESLIDING_FRACTION * float(np.max(w)) if len(w) else 0.0
+    label = f"|w| < {thr:.3g}"
+    g = w - thr                                   # < 0: stick
+    t = tr.t
+    cuts = [0.0]
+    for k in np.flatnonzero(np.sign(g[:-1]) != np.sign(g[1:])):
+        cuts.append(float(t[k] + (t[k + 1] - t[k]) * g[k] / (g[k] - g[k + 1])) if g[k] != g[k + 1] else float(t[k]))
+    cuts.append(T)
+    peaks = []
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        inside = (t >= a) & (t <= b)
+        peaks.append(float(np.max(w[inside])) if np.any(inside) else 0.0)
+    if len(peaks) > 1 and g[0] >= 0 and g[-1] >= 0:
+        peaks[0] = peaks[-1] = max(peaks[0], peaks[-1])      # one stretch across the period's end
+    segs = []
+    for (a, b), peak in zip(zip(cuts[:-1], cuts[1:]), peaks):
+        slip = peak >= SLIP_FRACTION * float(np.max(w))
+        segs.append((a, b, "slip" if slip else "stick", "slip" if slip else label))
+    return segs
+
+
+def phases_of(target: Target, period: float, event_times, modes, tr=None) -> tuple:
     """Stick and slip phases of each contact along one period (see Phase), from the mode
-    sequence ``modes`` (k + 1,) between the event times (k,) in [0, period]."""
+    sequence ``modes`` (k + 1,) between the event times (k,) in [0, period]; for a contact
+    without stick modes (LuGre) whose relative velocity is known, from |w| on the sampled
+    period ``tr`` (below PRESLIDING_FRACTION of its largest value: stick)."""
     sys_ = target.system
     T = float(period)
     bounds = np.concatenate([[0.0], np.asarray(event_times, dtype=float), [T]])
@@ -152,23 +211,11 @@ def phases_of(target: Target, period: float, event_times, modes) -> tuple:
     segs = [(bounds[i], bounds[i + 1], modes[i]) for i in range(len(modes)) if bounds[i + 1] >= bounds[i]]
     out = []
     for c in target.contacts:
-        pieces = []          # [kind, start, end, modes]
-        for a, b, m in segs:
-            kind = "stick" if m in c.stick else "slip"
-            name = sys_.modes[m].name if 0 <= m < sys_.n_modes else str(m)
-            if pieces and pieces[-1][0] == kind:
-                pieces[-1][2] = b
-                if pieces[-1][3][-1] != name:
-                    pieces[-1][3].append(name)
-            else:
-                pieces.append([kind, a, b, [name]])
-        if len(pieces) > 1 and pieces[0][0] == pieces[-1][0]:
-            # the period starts inside a phase: join its two ends
-            last = pieces.pop()
-            first = pieces[0]
-            pieces[0] = [first[0], last[1] - T, first[2], last[3] + [m for m in first[3] if m not in last[3]]]
-        start_idx = next((i for i, p in enumerate(pieces) if p[1] >= 0), 0)
-        pieces = pieces[start_idx:] + pieces[:start_idx]
+        if not c.stick and c.velocity is not None and tr is not None:
+            pieces = _pieces(_presliding_segments(c, tr, T), T)
+        else:
+            pieces = _pieces([(a, b, "stick" if m in c.stick else "slip",
+                               sys_.modes[m].name if 0 <= m < sys_.n_modes else str(m)) for a, b, m in segs], T)
         for kind, a, b, names in pieces:
             out.append(Phase(kind, float(b - a), float(a % T) if T > 0 else 0.0, c.name, tuple(names)))
     return tuple(out)
@@ -202,14 +249,14 @@ def _extremes(tr) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _described(target: Target, status, message, period, x0, lam, trivial_error, tr, event_times, modes,
-               stable, orbit, start) -> CycleResult:
+               stable, orbit, start, mode0=None) -> CycleResult:
     names = target.state_names
     lam = np.asarray(lam)
     lam = lam[np.argsort(-np.abs(lam), kind="stable")]
     lo, hi = _extremes(tr)
     return CycleResult(status, message, target.label, names, float(period), dict(zip(names, map(float, x0))),
                        lam, float(trivial_error), dict(zip(names, map(float, lo))), dict(zip(names, map(float, hi))),
-                       phases_of(target, period, event_times, modes), bool(stable), orbit, start)
+                       phases_of(target, period, event_times, modes, tr), bool(stable), orbit, start, mode0)
 
 
 def _result(target: Target, orbit: PeriodicOrbit, start: str) -> CycleResult:
@@ -241,7 +288,8 @@ def _result_from_map(target: Target, twin, fp, why: str) -> CycleResult:
     return _described(target, OrbitStatus.SUCCESS,
                       f"multipliers from the event map's slope dP^{fp.iterate}/dd (shooting: {why})", T, X0[0], lam,
                       0.0, tr, ev.t[inside], modes, fp.stable, None,
-                      f"event map of the Switch loop (stick error d = {d:.8g}, {fp.iterate} stick phases per period)")
+                      f"event map of the Switch loop (stick error d = {d:.8g}, {fp.iterate} stick phases per period)",
+                      int(mode0[0]))
 
 
 def _failure(target: Target, status: OrbitStatus, message: str, throw: bool) -> CycleResult:
@@ -412,7 +460,7 @@ def _transient(target: Target, xs, period_guess, start: StartOptions | None, sho
         status, msg = st.status, st.message
         if tried and not tried[-1].success:
             msg += f"; shooting from the returns gave {tried[-1].status.name}: {tried[-1].message}"
-    return _failure(target, status, f"{msg}. {status.advice}", throw)
+    return _failure(target, status, f"{msg}. {status.advice[0].upper()}{status.advice[1:]}", throw)
 
 
 # ------------------------------------------------------------------ the front end

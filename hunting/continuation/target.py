@@ -23,11 +23,13 @@ STICK_KINDS = ("stick", "filippov")
 
 @dataclass(frozen=True)
 class Contact:
-    """The modes of one friction contact: ``stick`` (indices of the system's modes in which the
-    contact sticks), ``name``."""
+    """One friction contact: ``name``, ``stick`` (indices of the system's modes in which it
+    sticks; empty for LuGre), ``velocity`` (callable (x, t) -> its relative velocity w, when
+    known: compiled models and the servo loops; else None)."""
 
     name: str
     stick: frozenset
+    velocity: Callable | None = field(default=None, repr=False, compare=False)
 
 
 @dataclass(frozen=True)
@@ -206,11 +208,16 @@ def _contacts_of(system: PiecewiseSystem, source) -> tuple:
                 stick = c.get("stick_modes", c.get("stick"))
             if stick is None:
                 continue
-            out.append(Contact(str(name), frozenset(int(m) for m in stick)))
+            w = None
+            if callable(getattr(source, "relative_velocity", None)):
+                w = (lambda x, t, k=k: source.relative_velocity(x, t, k))
+            out.append(Contact(str(name), frozenset(int(m) for m in stick), w))
         if out:
             return tuple(out)
     stick = frozenset(i for i, m in enumerate(system.modes) if m.kind in STICK_KINDS)
-    return (Contact("friction", stick),)
+    loop = source if hasattr(source, "model_code") else None
+    w = (lambda x, t: x[1]) if loop is not None else None          # the servo loops: w = x2
+    return (Contact("friction", stick, w),)
 
 
 def resolve(target, params: Mapping | None = None) -> Target:
@@ -239,12 +246,12 @@ def resolve(target, params: Mapping | None = None) -> Target:
         if target not in PRESETS:
             raise SystemDefinitionError(f"preset = {target!r} is not known: presets are {sorted(PRESETS)}")
         loop = build_preset(target, **params)
-        return Target(loop.system, loop.name, _contacts_of(loop.system, None), loop, (target, params), target)
+        return Target(loop.system, loop.name, _contacts_of(loop.system, loop), loop, (target, params), target)
     if isinstance(target, ServoLoop):
         if params:
             sys_ = target.system.with_params(params)
-            return Target(sys_, target.name, _contacts_of(sys_, None), None, None, sys_)
-        return Target(target.system, target.name, _contacts_of(target.system, None), target, None, target)
+            return Target(sys_, target.name, _contacts_of(sys_, target), None, None, sys_)
+        return Target(target.system, target.name, _contacts_of(target.system, target), target, None, target)
     if _is_model(target):
         model = target.with_params(**params) if params else target
         label = getattr(model, "name", None) or model.system.name

@@ -257,10 +257,12 @@ def settle(system: PiecewiseSystem, x0, *, period_guess: float | None = None, op
                            t_end=t + tr.t_final, x_end=tr.x_final.copy())
         if _chunk == 0:
             size0 = max(size0, float(np.max(xs.max(axis=0) - xs.min(axis=0))), 1e-300)
+            first = float(tr.t_final)
         big = float(np.max(np.abs(xs)))
         if big > opt.escape * size0:
-            return Settled(OrbitStatus.ESCAPE, f"max |x| = {big:.3g} at t <= {t + tr.t_final:.6g}, {opt.escape:g} times "
-                           f"the start's size {size0:.3g}", t_end=t + tr.t_final, x_end=tr.x_final.copy())
+            return Settled(OrbitStatus.ESCAPE, f"max |x| = {big:.3g} by t = {t + tr.t_final:.6g}: more than "
+                           f"{opt.escape:g} times the start's size ({size0:.3g}: the larger of |x0| and the range "
+                           f"of the first {first:.3g} time units)", t_end=t + tr.t_final, x_end=tr.x_final.copy())
         partial = tr.status.name in ("MAX_EVENTS", "MAX_STEPS")     # the chunk ended early: shorter ones next
         if not tr.success and not partial:
             return Settled(OrbitStatus.INTEGRATION_FAILED, f"the transient's integration stopped at t = "
