@@ -63,7 +63,8 @@ def model(description, /, **overrides) -> CompiledModel:
         a path to a JSON/YAML file, JSON text, or the name of a thesis preset ("table9.1",
         "table8.1-lugre", ...: the preset written as a description).
     **overrides : float
-        Parameter values replacing the description's defaults.
+        Parameter values replacing the description's defaults (for a preset name: the preset's
+        overrides, e.g. ``beta=float("inf")`` or ``model="lugre"``).
 
     The generated code is cached on disk by the description's structure (parameter values are
     not part of it), so a second process, or the same model at other parameter values, does
@@ -90,8 +91,8 @@ def model(description, /, **overrides) -> CompiledModel:
                 raise SystemDefinitionError(f"the model description text is not valid JSON: {e}") from None
         elif not Path(s).exists() and isinstance(description, str):
             from ..models.presets import PRESETS, preset_description
-            if s in PRESETS:
-                return model(preset_description(s), **overrides)
+            if s in PRESETS:         # preset overrides may change the structure (model=, beta=inf)
+                return model(preset_description(s, **overrides))
             raise SystemDefinitionError(f"model = {s!r} is neither a model file nor a preset: presets are "
                                         f"{sorted(PRESETS)}")
         else:

@@ -41,7 +41,12 @@ PART = np.array({part}, dtype=np.int64).reshape({nmodes}, {ncp})
 
 @numba.njit(cache=True, error_model="numpy", inline="always", _nrt=False)
 def _pw(b, e):
-    """b**e extended past b = 0: analytic for integer e, 0 for b < 0 otherwise."""
+    """b**e extended past b = 0: analytic for integer e, 0 for b < 0 otherwise (the presets'
+    pow_ext; e = 2 and e = 1 without a power call)."""
+    if e == 2.0:
+        return b * b
+    if e == 1.0:
+        return b
     if b >= 0.0 or e == math.floor(e):
         return b ** e
     return 0.0

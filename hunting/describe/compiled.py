@@ -185,13 +185,14 @@ class CompiledModel:
         """The flat parameter array with named values replaced (checked, not stored)."""
         new = np.array(self.system.params, dtype=np.float64)
         for k, v in {**(values or {}), **kw}.items():
+            slot = self.layout.param(k)
             try:
                 val = float(v)
             except (TypeError, ValueError):
                 raise SystemDefinitionError(f"parameter {k} = {v!r} is not a number") from None
             if not math.isfinite(val):
                 raise SystemDefinitionError(f"parameter {k} = {v!r} is not allowed: values must be finite")
-            new[self.layout.param(k)] = val
+            new[slot] = val
         self._spec.check_parameter_values(dict(zip(self.param_names, new)))
         return new
 
@@ -201,9 +202,10 @@ class CompiledModel:
         Examples
         --------
         >>> import hunting
-        >>> m = hunting.model("examples/belt.json")           # doctest: +SKIP
-        >>> m.with_params(k=3.0).system.param("k")            # doctest: +SKIP
-        3.0
+        >>> m = hunting.model({"parameters": {"k": 1.0, "c": 0.1}, "states": ["q", "v"],
+        ...                    "equations": {"q": "v", "v": "-k*q - c*v"}})
+        >>> m.with_params(k=3.0).system.param("k"), m.system.param("k")
+        (3.0, 1.0)
         """
         new = copy.copy(self)
         new.system = self.system.with_param_array(self.params_with(values, **kw))
@@ -215,8 +217,11 @@ class CompiledModel:
 
         Examples
         --------
-        >>> m.state(q=0.1)                                    # doctest: +SKIP
-        array([0.1, 0. ])
+        >>> import hunting
+        >>> m = hunting.model({"parameters": {"k": 1.0, "c": 0.1}, "states": ["q", "v"],
+        ...                    "equations": {"q": "v", "v": "-k*q - c*v"}})
+        >>> m.state(q=0.1).tolist()
+        [0.1, 0.0]
         """
         x = np.zeros(self.n_states)
         for k, v in self._spec.initial.items():
@@ -225,8 +230,9 @@ class CompiledModel:
             if c.model == "lugre":
                 x[self.layout.state(c.state)] = c.z0
         for k, v in named.items():
+            i = self.layout.state(k)
             try:
-                x[self.layout.state(k)] = float(v)
+                x[i] = float(v)
             except (TypeError, ValueError):
                 raise SystemDefinitionError(f"state {k} = {v!r} is not a number") from None
         return self.system.check_state(x)

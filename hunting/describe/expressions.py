@@ -45,7 +45,8 @@ class Expr:
 
 
 def _fail(where: str, text: str, problem: str, node: ast.AST | None = None) -> SystemDefinitionError:
-    pos = f" at position {node.col_offset + 1}" if node is not None and hasattr(node, "col_offset") else ""
+    lead = len(text) - len(text.lstrip())        # the parser saw the text without leading blanks
+    pos = f" at position {node.col_offset + 1 + lead}" if node is not None and hasattr(node, "col_offset") else ""
     return SystemDefinitionError(f"{where} = {text!r}: {problem}{pos}")
 
 
@@ -66,7 +67,7 @@ def parse(text, where: str) -> Expr:
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as e:
-        col = f" at position {e.offset}" if e.offset else ""
+        col = f" at position {e.offset + len(text) - len(text.lstrip())}" if e.offset else ""
         raise SystemDefinitionError(f"{where} = {text!r}: not a valid expression ({e.msg}){col}") from None
     names: set = set()
     _check(tree.body, where, text, names)

@@ -234,7 +234,11 @@ def build(spec: Spec) -> Symbolic:
         cand = [(k, d) for k, d in cand if d != 0]
         if not cand:
             raise SystemDefinitionError(f"friction[{c.name!r}].velocity = {c.velocity.text!r} depends on no state")
-        k, d = next(((k, d) for k, d in cand if not d.has(x[k])), cand[0])
+        # the stick entry moves this state onto w = 0: one the velocity is linear in, and not
+        # the surface state of an earlier contact (a second contact must not undo the first)
+        used = set(surface)
+        k, d = next(((k, d) for k, d in cand if not d.has(x[k]) and k not in used),
+                    next(((k, d) for k, d in cand if not d.has(x[k])), cand[0]))
         w.append(wc)
         surface.append(k)
         dwdx.append(d)

@@ -19,20 +19,15 @@ def _num(v) -> float:
 
 def _stribeck(sfx: str, v: dict, params: dict) -> str:
     """g(|w|) of one direction with its parameters added to ``params`` (suffix '' or '_neg');
-    an integer exponent is written into the expression (w**2 costs less than a power call)."""
+    beta = inf is the discontinuous curve g = Fc (a different structure: the exponent is gone)."""
     get = lambda k: v.get(k + sfx, v[k])  # noqa: E731
     for k in ("Fc", "Fs", "vs", "b"):
         params[k + sfx] = _num(get(k))
     beta = _num(get("beta"))
-    Fc, Fs, vs = f"Fc{sfx}", f"Fs{sfx}", f"vs{sfx}"
     if math.isinf(beta):
-        return Fc
-    if beta == int(beta) and 1 <= beta <= 4:
-        expo = "" if beta == 1 else f"**{int(beta)}"
-    else:
-        params["beta" + sfx] = beta
-        expo = f"**beta{sfx}"
-    return f"({Fc} + ({Fs} - {Fc})*exp(-(abs(w)/{vs}){expo}))"
+        return f"Fc{sfx}"
+    params["beta" + sfx] = beta
+    return f"(Fc{sfx} + (Fs{sfx} - Fc{sfx})*exp(-(abs(w)/vs{sfx})**beta{sfx}))"
 
 
 def servo_description(values: dict, name: str = "servo") -> dict:
