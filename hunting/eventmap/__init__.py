@@ -4,6 +4,9 @@ from .basins import basins
 from .bifurcation import MapDiagram, default_grid, map_diagram
 from .engine import EventMap, MapOptions, MapValues, evaluate_map, event_map, stick_map
 from .fixedpoints import FixedPoint, OriginSlope, fixed_points, origin_slope
+from .origin import LinearOrigin, linear_origin
+from .resolution import MapResolution, check_resolution
 
 __all__ = ["Attractor", "attractors", "basins", "MapDiagram", "default_grid", "map_diagram", "EventMap", "MapOptions", "MapValues",
-           "evaluate_map", "event_map", "stick_map", "FixedPoint", "OriginSlope", "fixed_points", "origin_slope"]
+           "evaluate_map", "event_map", "stick_map", "FixedPoint", "OriginSlope", "fixed_points", "origin_slope",
+           "LinearOrigin", "linear_origin", "MapResolution", "check_resolution"]
