@@ -45,11 +45,35 @@ def _finish(fig, ax, own: bool, title: str, path) -> None:
             save(fig, path)
 
 
+THESIS_STYLE = dict(marker="x", color="C3", ms=9, mew=2.0, ls="none", zorder=6)
+
+
+def thesis_marks(ax, x, y, *, label: str = "thesis") -> None:
+    """The thesis' values as red crosses (one legend entry), beside ours."""
+    ax.plot(np.atleast_1d(x), np.atleast_1d(y), label=label, **THESIS_STYLE)
+
+
+def thesis_table(ax, rows, *, loc: str = "lower right", title: str = "") -> None:
+    """A small table in the axes: for each row (label, thesis, ours, format) the thesis value
+    beside ours ("hunting"), so a figure carries the check it illustrates."""
+    lines = [f"{'':<16}{'thesis':>10}{'hunting':>12}"]
+    for label, thesis, ours, fmt in rows:
+        t = thesis if isinstance(thesis, str) else format(thesis, fmt)
+        o = ours if isinstance(ours, str) else format(ours, fmt)
+        lines.append(f"{label:<16}{t:>10}{o:>12}")
+    text = (title + "\n" if title else "") + "\n".join(lines)
+    pos = {"lower right": (0.98, 0.03, "right", "bottom"), "upper right": (0.98, 0.97, "right", "top"),
+           "lower left": (0.02, 0.03, "left", "bottom"), "upper left": (0.02, 0.97, "left", "top"),
+           "center right": (0.98, 0.5, "right", "center")}[loc]
+    ax.text(pos[0], pos[1], text, transform=ax.transAxes, ha=pos[2], va=pos[3], family="monospace", fontsize=7,
+            bbox=dict(boxstyle="round", fc="white", ec="0.6", alpha=0.9), zorder=10)
+
+
 def plot_trajectory(traj, *, title: str = "", stick_modes=(), units: dict | None = None, path=None):
     """Time responses of every state and a phase portrait (x1, x2, x3 in 3-D).
 
-    Stick phases (modes in ``stick_modes``) are shaded; event states are marked with circles.
-    Returns the figure; saves it when ``path`` is given."""
+    Stick phases (modes in ``stick_modes``) are shaded (with a legend entry); event states are
+    marked with circles. Returns the figure; saves it when ``path`` is given."""
     plt = _plt()
     units = units or {}
     n = traj.x.shape[1]
@@ -59,8 +83,10 @@ def plot_trajectory(traj, *, title: str = "", stick_modes=(), units: dict | None
     for i in range(n):
         ax = fig.add_subplot(gs[i, 0])
         ax.plot(traj.t, traj.x[:, i], lw=1.0, color="C0")
-        for a, b in intervals:
-            ax.axvspan(a, b, color="0.85", lw=0)
+        for j, (a, b) in enumerate(intervals):
+            ax.axvspan(a, b, color="0.85", lw=0, label="stick phase" if j == 0 else None)
+        if i == 0 and len(intervals):
+            ax.legend(fontsize=8, loc="best")
         name = traj.state_names[i] if traj.state_names else f"x{i + 1}"
         ax.set_ylabel(f"{name} [{units.get(name, '-')}]")
         ax.grid(alpha=0.3)
@@ -121,7 +147,7 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
     fig, ax, own = _axes(ax, (5.6, 5.0))
     k = em.iterate
     lab = "P(d)" if k == 1 else f"P$^{k}$(d)"
-    ax.plot(em.grid, em.image, ".", ms=2.0, color="C0", label=lab)
+    ax.plot(em.grid, em.image, ".", ms=2.0 if em.grid.size > 200 else 5.0, color="C0", label=lab)
     lo, hi = float(np.nanmin(em.grid)), float(np.nanmax(em.grid))
     ax.plot([lo, hi], [lo, hi], "-", color="0.4", lw=0.8, label="diagonal")
     ax.axhline(0, color="0.8", lw=0.6)
@@ -136,9 +162,13 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
             xs.append(float(mv.image[0]))
         ax.plot(*cobweb_path(xs), "-", color="C3", lw=0.9, label="cobweb")
         ax.plot(xs[:-1], xs[1:], "o", color="C3", ms=4)
+    labelled = set()
     for f in fixed:
         for d in ([f.d] if f.kind == "equilibrium" else [f.d, -f.d] if em.loop.odd and em.grid.min() < 0 else [f.d]):
-            ax.plot(d, d, "o", ms=7, mfc="k" if f.stable else "w", mec="k", zorder=5)
+            key = "stable" if f.stable else "unstable"
+            ax.plot(d, d, "o", ms=7, mfc="k" if f.stable else "w", mec="k", zorder=5,
+                    label=None if key in labelled else f"{key} fixed point")
+            labelled.add(key)
     ax.set_xlabel(f"d$^n$ [{unit}]")
     ax.set_ylabel(f"d$^{{n+{k}}}$ [{unit}]")
     ax.grid(alpha=0.3)

@@ -83,7 +83,9 @@ def run(out: Path) -> int:
         L.fact(f"{name}: one cycle, stable", (len(c3), all(c.stable for c in c3)), (1, True))
         if c3:
             L.number(f"{name}: d2*", c3[0].d, dstar, 1e-4, "m")
-        print(f"    origin: {e3.origin.behaviour}, P^2(delta)/delta = {e3.slope:.3g} at delta = {e3.origin.probes[0][-1]:.1e}")
+        how = ("slope of the linearization" if e3.origin.method == "linearization" else
+               f"P^2(delta)/delta at delta = {e3.origin.probes[0][-1]:.1e}")
+        print(f"    origin: {e3.origin.behaviour}, {how}: {e3.slope:.3g}")
         plot_event_map(em, fixed=f3, title=f"Fig. 9.7: P$^2$, {name}", ax=ax)
     fig.tight_layout()
     save(fig, out / "fig9_7.png")
