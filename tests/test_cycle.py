@@ -188,6 +188,7 @@ def test_docstring_examples():
     import hunting.continuation.status as St
     import hunting.continuation.target as T
     import hunting.continuation.transient as Tr
-    for mod in (C, H, S, St, T, Tr):
+    import hunting.eventmap.family as F
+    for mod in (C, H, S, St, T, Tr, F):
         res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
         assert res.failed == 0, mod.__name__

@@ -64,3 +64,12 @@ def test_systems_without_a_one_parameter_stick_family_are_named():
         stick_family(two_mass_system(A=0.0))     # mass 2 moves while mass 1 sticks
     with pytest.raises(hunting.SystemDefinitionError, match="one Switch friction contact"):
         stick_family(hunting.model(PID_LUGRE_DESCRIPTION))
+
+
+def test_map_diagram_of_a_model_by_parameter_name():
+    """The fold of Table 9.1's cycle pair (P = 21.015, thesis: between 21 and 22) from the
+    described PID servo, its gain swept by name."""
+    from hunting.eventmap import map_diagram
+    dg = map_diagram(hunting.model(PID_SWITCH), "P", [20.5, 21.5], d_max=0.4)
+    folds = [s for s in dg.special if s.kind == "fold"]
+    assert len(folds) == 1 and folds[0].param == pytest.approx(21.015, abs=2e-3)
