@@ -107,9 +107,12 @@ class Branch:
     state_names: tuple = ()
 
     def as_dict(self) -> dict:
+        names = self.state_names or tuple(f"x{i + 1}" for i in range(self.x0.shape[1] if self.x0.ndim == 2 else 0))
         pts = [dict(param=float(m), period=float(T), amplitude=float(a),
-                    multipliers=[[float(z.real), float(z.imag)] for z in lam], stable=bool(s))
-               for m, T, a, lam, s in zip(self.mu, self.period, self.amplitude, self.multipliers, self.stable)]
+                    multipliers=[[float(z.real), float(z.imag)] for z in lam], stable=bool(s),
+                    x0={k: float(v) for k, v in zip(names, x)})
+               for m, T, a, lam, s, x in zip(self.mu, self.period, self.amplitude, self.multipliers, self.stable,
+                                             self.x0)]
         return dict(param=self.param, label=self.label, status=self.status.name, message=self.message,
                     points=pts, special_points=[s.as_dict() for s in self.special])
 

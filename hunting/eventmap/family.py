@@ -282,7 +282,7 @@ def stick_family(obj, *, d_state: str | None = None, seed: int = 0) -> StickFami
     if r1 == r0:
         raise SystemDefinitionError(f"{name}: the drift of {names[ei]} in stick does not depend on {names[di]}: "
                                     f"no stick error to map")
-    d0 = -r0 / (r1 - r0)
+    d0 = -r0 / (r1 - r0) + 0.0          # + 0.0: no negative zero
     x[di] = d0 + 0.7
     x2 = x.copy()
     x2[ei] += 1.0
