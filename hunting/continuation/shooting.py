@@ -220,32 +220,6 @@ def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
     return orbit
 
 
-def cycle_guess(system: PiecewiseSystem, x0, *, t_settle: float, section: int = 0, params=None,
-                method: str = "dop853", max_time: float = 1e4) -> tuple[np.ndarray, float]:
-    """A starting guess for shooting: simulate from x0 for t_settle, then find two successive
-    upward crossings of x[section] = 0 (with the velocity state x[1] > 0); returns (state at the
-    second crossing, time between them)."""
-    sys_ = system if params is None else system.with_param_array(params)
-    tr = simulate(sys_, x0, (0.0, t_settle), method=method, rtol=1e-10, atol=1e-13)
-    x = tr.x_final
-    t_end = min(max_time, 50 * t_settle + 100.0)
-    tr = simulate(sys_, x, (0.0, t_end), method=method, rtol=1e-10, atol=1e-13, t_eval=np.linspace(0, t_end, 200001))
-    s = tr.x[:, section]
-    up = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0) & (tr.x[1:, 1] > 0))
-    if up.size < 3:
-        raise ConvergenceError(f"{system.name}: no periodic crossing of x{section + 1} = 0 found after "
-                               f"t_settle = {t_settle}: the motion may settle (no hunting) — try another start", tr)
-    i, j = up[-2], up[-1]
-    # refine the crossing by linear interpolation, then re-simulate to it exactly
-    def cross(k):
-        a, b = s[k], s[k + 1]
-        return tr.t[k] + (tr.t[k + 1] - tr.t[k]) * (-a) / (b - a)
-    t1, t2 = cross(i), cross(j)
-    x1 = simulate(sys_, x, (0.0, t1), method=method, rtol=1e-10, atol=1e-13).x_final.copy()
-    x1[section] = 0.0
-    return x1, float(t2 - t1)
-
-
 def guess_from_stick_error(loop, d: float, *, section: int = 0) -> tuple[np.ndarray, float]:
     """A shooting guess for the symmetric stick-slip cycle with stick error |d| (a fixed point of
     the event map): start at the break-away state of -|d|, find the first upward crossing of
