@@ -192,3 +192,14 @@ def test_docstring_examples():
     for mod in (C, H, S, St, T, Tr, F):
         res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
         assert res.failed == 0, mod.__name__
+
+
+def test_follow_a_described_lugre_loop_by_name():
+    """The PID + LuGre model's branch in kp: its shooting section is the one the search chose
+    (the position is almost stationary where the search found its x0), the end point against a
+    fresh search."""
+    m = hunting.model(PID_LUGRE_DESCRIPTION)
+    br = follow(m, "kp", 3.0, 3.3)
+    assert br.status == OrbitStatus.SUCCESS and br.mu[-1] >= 3.3 and len(br.mu) < 20
+    end = find_cycle(m.with_params(kp=float(br.mu[-1])))
+    assert br.period[-1] == pytest.approx(end.period, rel=1e-7)

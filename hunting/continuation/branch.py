@@ -136,7 +136,7 @@ def _nontrivial_near(lam, target):
 
 
 def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: PeriodicOrbit, mu0: float,
-                   mu_end: float, *, param: str = "mu", section: int = 0,
+                   mu_end: float, *, param: str = "mu", section: int | None = None,
                    options: ContinuationOptions | None = None, shooting: ShootingOptions | None = None,
                    stop_at_mu: float | None = None, max_turns: int = 1,
                    amplitude: Callable[[PiecewiseSystem, np.ndarray, float, Flow], float] | None = None,
@@ -152,6 +152,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     mu0, mu_end : float
         Start and end of the parameter range (mu0 != mu_end).
     param : name for the result; section : the state held fixed by the phase condition
+        (default: the orbit's own, where its shooting held it)
     options, shooting : ContinuationOptions, ShootingOptions
     stop_at_mu, max_turns : after ``max_turns`` folds the run stops once mu passes stop_at_mu
     amplitude : callable (system, x0, T, flow) -> float, optional
@@ -173,6 +174,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     opt = options or ContinuationOptions()
     sopt = shooting or ShootingOptions()
     n = len(orbit.x0)
+    section = orbit.section if section is None else int(section)
     free = [i for i in range(n) if i != section]
     c_sec = float(orbit.x0[section])
     scale = np.concatenate([np.maximum(np.abs(orbit.x0[free]), 1e-3 * np.max(np.abs(orbit.x0))),

@@ -92,9 +92,11 @@ def follow(system, param: str, start: float, end: float, *, params: dict | None 
         orbit = res.orbit
     opt = options or ContinuationOptions()
     loop = at_start.loop
-    lugre = loop is not None and loop.model_code == S.MODEL_LUGRE
+    contacts = getattr(at_start.source, "contacts", None) or ()
+    lugre = ((loop is not None and loop.model_code == S.MODEL_LUGRE)
+             or any(getattr(c, "model", None) == "lugre" for c in contacts))
     if opt.jacobian_method is None and lugre:
-        opt = replace(opt, jacobian_method="radau")       # the stiff loop's sensitivities: implicit
+        opt = replace(opt, jacobian_method="radau")       # stiff LuGre bristles: implicit sensitivities
     exact_servo = loop is not None and loop.model_code != S.MODEL_BANDED
     br = continue_orbit(lens.system_at, orbit, start, end, param=param, options=opt, shooting=shooting,
                         stop_at_mu=start if stop_at is None else stop_at,

@@ -51,7 +51,8 @@ class PeriodicOrbit:
     one first, then by decreasing modulus; trivial_error : |lambda_trivial - 1|; amplitude :
     max |x1| over the orbit; stable : every non-trivial |lambda| < 1; status : OrbitStatus;
     message : what happened and, on failure, what to change; iterations : Newton iterations;
-    residual : final scaled residual; params : the flat parameter array of the orbit."""
+    residual : final scaled residual; params : the flat parameter array of the orbit;
+    section : the state held fixed by the phase condition (x0[section] is on the section)."""
 
     x0: np.ndarray
     period: float
@@ -67,6 +68,7 @@ class PeriodicOrbit:
     iterations: int
     residual: float
     params: np.ndarray = field(repr=False, default=None)
+    section: int = 0
 
     @property
     def success(self) -> bool:
@@ -214,7 +216,7 @@ def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
     amp = orbit_amplitude(system, x, T, p, method=opt.method) if status == OrbitStatus.SUCCESS else np.nan
     stable = bool(np.all(np.abs(mult[1:]) < 1.0)) if status == OrbitStatus.SUCCESS else False
     orbit = PeriodicOrbit(x, float(T), tuple(int(m) for m in fl.modes), fl.event_times, fl.Phi, mult, triv, amp,
-                          stable, status, message, it, res, p)
+                          stable, status, message, it, res, p, section)
     if throw and status != OrbitStatus.SUCCESS:
         raise ConvergenceError(f"{system.name}: shooting failed: {message}", orbit)
     return orbit
