@@ -38,6 +38,7 @@ def test_api_names_layout_and_state():
     assert m2.system.param("k") == 3.0 and m.system.param("k") == 2.0
     assert m2.system.vector_field is m.system.vector_field          # nothing recompiled
     assert m2.description["parameters"]["k"] == 3.0
+    assert "contact friction (switch): force F, w = v - vb" in m.summary() and "k                = 2" in m.summary()
 
 
 @pytest.mark.parametrize("name, x0, method", [("table9.1", [0.1, 0.0, 0.0], "dop853"),
@@ -290,9 +291,15 @@ def test_belt_against_solve_ivp_with_stick_events():
 
 def test_pid_lugre_loop_against_solve_ivp():
     """Canudas de Wit et al. (1995): PID (kp 3, kv 6, ki 4) on a unit mass with LuGre friction
-    hunts around x_d = 1; scipy's Radau with restarts at v = 0 (the kink of |v|)."""
+    hunts around x_d = 1; scipy's Radau with restarts at v = 0 (the kink of |v|). The model
+    carries a LuGre observer zh written with abs(v): abs of a contact velocity takes the mode's
+    side in the equations too, so the field has no kink inside a mode and zh follows z."""
     from scipy.integrate import solve_ivp
-    m = hunting.load_model(EXAMPLES / "pid_lugre.json")
+    d = json.loads((EXAMPLES / "pid_lugre.json").read_text())
+    d["states"].append("zh")
+    d["equations"]["zh"] = "v - sigma0*abs(v)*zh/(Fc + (Fs - Fc)*exp(-(v/vs)**2))"
+    m = hunting.model(d)
+    assert "abs(" not in m.cache_path.read_text().split("def vf")[1].split("def guards")[0]
     p = dict(zip(m.param_names, m.params))
 
     def f(t, y):
@@ -321,6 +328,7 @@ def test_pid_lugre_loop_against_solve_ivp():
     tr = hunting.simulate(m.system, m.state(), (0, T), method="radau", rtol=1e-10, atol=1e-13, t_eval=te)
     X = np.array([ref[s] for s in te])
     assert np.abs(tr.x[:, :3] - X[:, :3]).max() < 1e-8 and np.abs(tr.x[:, 3] - X[:, 3]).max() < 1e-12
+    assert np.abs(tr.x[:, 4] - tr.x[:, 3]).max() < 1e-18
     assert tr.x[:, 0].max() > 1.4 and len(tr.events) >= 3          # it hunts: overshoot and reversals
 
 
@@ -552,3 +560,53 @@ def test_docstring_examples():
     for mod in (api, compiled):
         res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
         assert res.failed == 0 and res.attempted > 0
+
+
+def test_servo_loop_description_with_cogging_and_asymmetric_friction():
+    """ServoLoop.description(): gains form, direction-dependent curve, cogging harmonics and a
+    constant force, against the hand-written kernel (vector field and guards in every mode)."""
+    from hunting.models import PID, Cogging, Plant, ServoLoop, StribeckCurve, Switch
+    from hunting.models.friction import DirectionalCurve
+    loop = ServoLoop(Plant(2.0, 1.5, setpoint=0.01, cogging=Cogging.harmonic(0.02, cos=[0.3, 0.1], sin=[0.2, 0.0]),
+                           external_force=0.4),
+                     Switch(DirectionalCurve(StribeckCurve(1.0, 1.5, 0.05, 0.7, 0.2), StribeckCurve(0.8, 1.1, 0.03, 2.0, 0.3))),
+                     PID(20.0, 3.0, 10.0))
+    m = loop.as_model()
+    assert set(m.param_names) >= {"kp", "kd", "ki", "Fc_neg", "cog_a2", "f_ext"}
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        x = rng.normal(size=3) * [0.01, 0.1, 0.01]
+        for mode in range(3):
+            x = x * [1, 0, 1] if mode == 2 else x          # stick holds x2 = 0
+            np.testing.assert_allclose(m.system.evaluate(x, mode=mode), loop.system.evaluate(x, mode=mode),
+                                       rtol=1e-12, atol=1e-12)
+            np.testing.assert_allclose(m.system.guard_values(x, mode=mode), loop.system.guard_values(x, mode=mode),
+                                       rtol=1e-12, atol=1e-12)
+        xr = x * [1, 0, 1]
+        assert m.system.initial_mode(xr) == loop.system.initial_mode(xr)
+
+
+def test_belt_flow_sensitivities_across_stick_and_slip():
+    """Monodromy-type Jacobians of the described belt (saltation at stick entry and break-away)
+    and the parameter sensitivity by name, against central differences of the flow map."""
+    from hunting.continuation import flow
+    from hunting.continuation.flow import fd_jacobian
+    m = hunting.load_model(EXAMPLES / "belt.json")
+    x0 = np.array([0.1, -0.05])
+    kw = dict(rtol=1e-12, atol=1e-14)
+    f = flow(m.system, x0, 9.0, param_direction=m.param_direction("k"), **kw)
+    assert list(f.modes) == [1, 2, 1, 2, 1]                   # slip-, stick, slip-, stick, slip-
+    np.testing.assert_allclose(f.Phi, fd_jacobian(m.system, x0, 9.0, **kw), atol=2e-8)
+    h = 1e-6
+    xp = flow(m.with_params(k=2 + h).system, x0, 9.0, sensitivity=False, **kw).x
+    xm = flow(m.with_params(k=2 - h).system, x0, 9.0, sensitivity=False, **kw).x
+    np.testing.assert_allclose(f.dx_dmu, (xp - xm) / (2 * h), atol=1e-7)
+
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.yaml")),
+                         ids=lambda p: p.name)
+def test_example_files_load_and_run(path):
+    m = hunting.load_model(path)
+    tr = hunting.simulate(m.system, m.state(), (0.0, 0.5), method="radau", rtol=1e-8, atol=1e-12)
+    assert tr.success and m.description["name"] == m.name

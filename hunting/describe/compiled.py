@@ -3,14 +3,13 @@ with its names, parameter layout and friction contacts."""
 from __future__ import annotations
 
 import copy
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
 import numpy as np
 
-from ..errors import SystemDefinitionError
+from ..errors import SystemDefinitionError, check_finite
 from ..system import Mode, PiecewiseSystem
 from . import cache
 from .description import GENERATOR_VERSION, Spec
@@ -30,19 +29,17 @@ class Layout:
 
     def param(self, name: str) -> int:
         """Slot of parameter ``name`` in the flat parameter array."""
-        try:
-            return self.param_names.index(name)
-        except ValueError:
-            raise SystemDefinitionError(f"parameter {name!r} is not a parameter of this model: "
-                                        f"parameters are {list(self.param_names)}") from None
+        return _index(self.param_names, name, "parameter")
 
     def state(self, name: str) -> int:
         """Index of state ``name`` in the state vector."""
-        try:
-            return self.state_names.index(name)
-        except ValueError:
-            raise SystemDefinitionError(f"state {name!r} is not a state of this model: "
-                                        f"states are {list(self.state_names)}") from None
+        return _index(self.state_names, name, "state")
+
+
+def _index(names: tuple, name: str, what: str) -> int:
+    if name not in names:
+        raise SystemDefinitionError(f"{what} {name!r} is not a {what} of this model: {what}s are {list(names)}")
+    return names.index(name)
 
 
 @dataclass(frozen=True)
@@ -186,12 +183,7 @@ class CompiledModel:
         new = np.array(self.system.params, dtype=np.float64)
         for k, v in {**(values or {}), **kw}.items():
             slot = self.layout.param(k)
-            try:
-                val = float(v)
-            except (TypeError, ValueError):
-                raise SystemDefinitionError(f"parameter {k} = {v!r} is not a number") from None
-            if not math.isfinite(val):
-                raise SystemDefinitionError(f"parameter {k} = {v!r} is not allowed: values must be finite")
+            val = check_finite(f"parameter {k}", v)
             new[slot] = val
         self._spec.check_parameter_values(dict(zip(self.param_names, new)))
         return new
@@ -230,11 +222,7 @@ class CompiledModel:
             if c.model == "lugre":
                 x[self.layout.state(c.state)] = c.z0
         for k, v in named.items():
-            i = self.layout.state(k)
-            try:
-                x[i] = float(v)
-            except (TypeError, ValueError):
-                raise SystemDefinitionError(f"state {k} = {v!r} is not a number") from None
+            x[self.layout.state(k)] = check_finite(f"state {k}", v)
         return self.system.check_state(x)
 
     # ------------------------------------------------------------------ evaluation
@@ -271,6 +259,26 @@ class CompiledModel:
         J = np.zeros((self.n_states, len(self.param_names)))
         self._module.pjac(self._mode(x, t, mode), float(t), x, self.system.params, J)
         return J
+
+    def summary(self) -> str:
+        """Text listing of the model: states, parameters with values, signals, contacts, modes
+        (for command-line listings)."""
+        d = self._spec.description
+        lines = [f"{self.name}: {self.n_states} states, {len(self.mode_names)} modes"]
+        lines.append("  states: " + ", ".join(self.state_names))
+        lines += [f"  {k:<16} = {v:<14.6g} parameter" for k, v in zip(self.param_names, self.params)]
+        lines += [f"  {k:<16} = {v}" for k, v in d["signals"].items()]
+        lines += [f"  d{k}/dt = {v}" for k, v in d["equations"].items()]
+        for c, cd in zip(self.contacts, d["friction"]):
+            law = (f"slip {cd['slip']}, stick [-({cd['stick'][0]}), {cd['stick'][1]}]" if c.model == "switch"
+                   else f"level {cd['level']}, sigma0 {cd['sigma0']}, sigma1 {cd['sigma1']}, viscous {cd['viscous']}")
+            lines.append(f"  contact {c.name} ({c.model}): force {c.force}, w = {c.velocity}; {law}")
+        for b in d["blocks"]:
+            what = b.get("tf") or (f"delay {b['delay']} (Pade {b['order']})" if "delay" in b
+                                   else f"num {b['num']} / den {b['den']}")
+            lines.append(f"  block {b['output']} = [{what}] ({b['input']})")
+        lines.append("  modes: " + ", ".join(f"{i} {n}" for i, n in enumerate(self.mode_names)))
+        return "\n".join(lines)
 
     def __repr__(self) -> str:
         return (f"CompiledModel({self.name!r}, states={list(self.state_names)}, "

@@ -403,6 +403,9 @@ def _block(b, i, everything, params, what) -> BlockSpec:
                                     "(coefficient lists, descending powers of s) or 'delay' (with 'order')")
     coeff = "coefficients use parameters only"
     if "tf" in b:
+        if TF_VARIABLE in params:
+            raise SystemDefinitionError(f"{w}.tf: the parameter {TF_VARIABLE!r} has the name of the Laplace variable "
+                                        "of transfer functions: rename it")
         tf = _expr(b["tf"], f"{w}.tf", params | {TF_VARIABLE}, "a transfer function uses s and parameters")
         return BlockSpec(b["output"], inp, tf=tf)
     if "num" in b:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import ast
 import math
+import operator
 from dataclasses import dataclass
 
 from ..errors import SystemDefinitionError
@@ -121,7 +122,30 @@ def _check(node, where, text, names) -> None:
                              f"+ - * / **, unary minus, {', '.join(FUNCTIONS)})", node)
 
 
-# ------------------------------------------------------------------------- numeric evaluation
+# ------------------------------------------------------------------------- evaluation
+
+_BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
+           ast.Pow: operator.pow}
+
+
+def _walk(expr: Expr, number, name, call):
+    """Fold a checked tree bottom-up: number(value), name(id) and call(function, args) give the
+    leaves and calls; the arithmetic is Python's operators (floats or sympy objects alike)."""
+
+    def ev(node):
+        if isinstance(node, ast.Constant):
+            return number(node.value)
+        if isinstance(node, ast.Name):
+            return name(node.id)
+        if isinstance(node, ast.UnaryOp):
+            v = ev(node.operand)
+            return -v if isinstance(node.op, ast.USub) else v
+        if isinstance(node, ast.BinOp):
+            return _BINARY[type(node.op)](ev(node.left), ev(node.right))
+        return call(node.func.id, [ev(a) for a in node.args])
+
+    return ev(expr.tree)
+
 
 def _sign(v: float) -> float:
     return 1.0 if v > 0 else (-1.0 if v < 0 else 0.0)
@@ -135,39 +159,18 @@ def evaluate(expr: Expr, values: dict) -> float:
     """Value of ``expr`` with every name taken from ``values`` (floats); raises
     SystemDefinitionError naming a missing name or a math domain error."""
 
-    def ev(node):
-        if isinstance(node, ast.Constant):
-            return float(node.value)
-        if isinstance(node, ast.Name):
-            if node.id in values:
-                return float(values[node.id])
-            if node.id in CONSTANTS:
-                return CONSTANTS[node.id]
-            raise SystemDefinitionError(f"{expr.text!r}: no value for {node.id!r}")
-        if isinstance(node, ast.UnaryOp):
-            v = ev(node.operand)
-            return -v if isinstance(node.op, ast.USub) else v
-        if isinstance(node, ast.BinOp):
-            a, b = ev(node.left), ev(node.right)
-            op = type(node.op)
-            if op is ast.Add:
-                return a + b
-            if op is ast.Sub:
-                return a - b
-            if op is ast.Mult:
-                return a * b
-            if op is ast.Div:
-                return a / b
-            return a ** b
-        return _MATH[node.func.id](*[ev(a) for a in node.args])
+    def name(n):
+        if n in values:
+            return float(values[n])
+        if n in CONSTANTS:
+            return CONSTANTS[n]
+        raise SystemDefinitionError(f"{expr.text!r}: no value for {n!r}")
 
     try:
-        return float(ev(expr.tree))
+        return float(_walk(expr, float, name, lambda f, args: _MATH[f](*args)))
     except (ValueError, ZeroDivisionError, OverflowError, TypeError) as e:
         raise SystemDefinitionError(f"{expr.text!r} cannot be evaluated at {values}: {e}") from None
 
-
-# ------------------------------------------------------------------------- sympy conversion
 
 def to_sympy(expr: Expr, symbols: dict):
     """The sympy expression of ``expr``; ``symbols`` maps every name it uses to a sympy object."""
@@ -176,31 +179,14 @@ def to_sympy(expr: Expr, symbols: dict):
     funcs = {"abs": sp.Abs, "sign": sp.sign, "exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt,
              "tanh": sp.tanh, "sin": sp.sin, "cos": sp.cos, "min": sp.Min, "max": sp.Max}
 
-    def cv(node):
-        if isinstance(node, ast.Constant):
-            v = node.value
-            return sp.Integer(v) if isinstance(v, int) else sp.Float(repr(v), 17)
-        if isinstance(node, ast.Name):
-            if node.id in symbols:
-                return symbols[node.id]
-            if node.id == "pi":
-                return sp.pi
-            raise SystemDefinitionError(f"{expr.text!r}: the name {node.id!r} is not known here")
-        if isinstance(node, ast.UnaryOp):
-            v = cv(node.operand)
-            return -v if isinstance(node.op, ast.USub) else v
-        if isinstance(node, ast.BinOp):
-            a, b = cv(node.left), cv(node.right)
-            op = type(node.op)
-            if op is ast.Add:
-                return a + b
-            if op is ast.Sub:
-                return a - b
-            if op is ast.Mult:
-                return a * b
-            if op is ast.Div:
-                return a / b
-            return a ** b
-        return funcs[node.func.id](*[cv(a) for a in node.args])
+    def number(v):
+        return sp.Integer(v) if isinstance(v, int) else sp.Float(repr(v), 17)
 
-    return cv(expr.tree)
+    def name(n):
+        if n in symbols:
+            return symbols[n]
+        if n == "pi":
+            return sp.pi
+        raise SystemDefinitionError(f"{expr.text!r}: the name {n!r} is not known here")
+
+    return _walk(expr, number, name, lambda f, args: funcs[f](*args))

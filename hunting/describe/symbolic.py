@@ -69,14 +69,13 @@ class Symbolic:
 
 
 def _pade(order: int, T):
-    """Coefficients (ascending powers of s) of the [order/order] Pade approximant of exp(-s T)."""
-    n = order
-    c = [factorial(2 * n - k) * factorial(n) / (factorial(2 * n) * factorial(k) * factorial(n - k))
-         for k in range(n + 1)]
+    """Coefficients (ascending powers of s) of the [order/order] Pade approximant of exp(-s T):
+    c_k (-s T)^k over c_k (s T)^k, c_k = (2n - k)! n! / ((2n)! k! (n - k)!), exact rationals."""
     import sympy as sp
-    num = [sp.Rational(c[k]).limit_denominator(10 ** 15) * (-T) ** k for k in range(n + 1)]
-    den = [sp.Rational(c[k]).limit_denominator(10 ** 15) * T ** k for k in range(n + 1)]
-    return num, den
+    n = order
+    c = [sp.Rational(factorial(2 * n - k) * factorial(n), factorial(2 * n) * factorial(k) * factorial(n - k))
+         for k in range(n + 1)]
+    return [c[k] * (-T) ** k for k in range(n + 1)], [c[k] * T ** k for k in range(n + 1)]
 
 
 def _block_coefficients(b: BlockSpec, psym: dict):
@@ -312,6 +311,16 @@ def build(spec: Spec) -> Symbolic:
                 zrates[c.state] = zdot
         # the laws may use signals, which never use forces: one substitution pass suffices
         f = [e.subs(subs) for e in raw]
+        # abs(w) and sign(w) of a slipping contact's velocity anywhere in the equations (an
+        # observer copying the bristle model, say) take the mode's side too: no kink inside a mode
+        kinks = {}
+        for ci, c in enumerate(contacts):
+            if not (c.model == "switch" and pt[ci] == STICK):
+                sgn = 1 if pt[ci] == SLIP_POS else -1
+                kinks[sp.Abs(w[ci])] = sgn * w[ci]
+                kinks[sp.sign(w[ci])] = sp.Integer(sgn)
+        if kinks:
+            f = [e.xreplace(kinks) for e in f]
         for name, zd in zrates.items():
             f[bristle_index[name]] = zd
         sticking = [ci for ci, c in enumerate(contacts) if c.model == "switch" and pt[ci] == STICK]
@@ -361,7 +370,8 @@ def build(spec: Spec) -> Symbolic:
                 wd[ci] = sp.diff(w[ci], t) + sum((sp.diff(w[ci], x[j]) * f[j] for j in range(len(x))), sp.Integer(0))
         wdot.append(wd)
         allsubs = {**subs, **fs}
-        signals.append([e.subs(allsubs) for e in sig_raw] + [F[c.force].subs(allsubs) for c in contacts])
+        signals.append([e.subs(allsubs).xreplace(kinks) for e in sig_raw]
+                       + [F[c.force].subs(allsubs).xreplace(kinks) for c in contacts])
         fv = sp.Matrix(f)
         jac.append(fv.jacobian(X).applyfunc(_clean))
         pjac.append(fv.jacobian(P).applyfunc(_clean) if p else sp.zeros(len(x), 0))

@@ -88,7 +88,7 @@ def servo_description(values: dict, name: str = "servo") -> dict:
     visc = "b*w"
     if asym:
         g_neg = _stribeck("_neg", v, p)
-        g = f"(1 + sign(w))/2*{g_pos} + (1 - sign(w))/2*{g_neg}"
+        g = f"((1 + sign(w))/2*{g_pos} + (1 - sign(w))/2*{g_neg})"
         visc = "(1 + sign(w))/2*b*w + (1 - sign(w))/2*b_neg*w"
     contact = {"name": "friction", "force": "F", "velocity": "x2", "model": model}
     states = ["x1", "x2", "x3"]
