@@ -53,14 +53,20 @@ def thesis_marks(ax, x, y, *, label: str = "thesis") -> None:
     ax.plot(np.atleast_1d(x), np.atleast_1d(y), label=label, **THESIS_STYLE)
 
 
-def thesis_table(ax, rows, *, loc: str = "lower right", title: str = "") -> None:
+def thesis_table(ax, rows, *, loc: str = "lower right", title: str = "", room: float = 0.0) -> None:
     """A small table in the axes: for each row (label, thesis, ours, format) the thesis value
-    beside ours ("hunting"), so a figure carries the check it illustrates."""
-    lines = [f"{'':<16}{'thesis':>10}{'hunting':>12}"]
-    for label, thesis, ours, fmt in rows:
-        t = thesis if isinstance(thesis, str) else format(thesis, fmt)
-        o = ours if isinstance(ours, str) else format(ours, fmt)
-        lines.append(f"{label:<16}{t:>10}{o:>12}")
+    beside ours ("hunting"), so a figure carries the check it illustrates. ``room``: widen the
+    y range by this fraction on the table's side so that it does not cover the data."""
+    if room > 0:
+        lo, hi = ax.get_ylim()
+        span = hi - lo
+        ax.set_ylim((lo - room * span, hi) if loc.startswith("lower") else (lo, hi + room * span))
+    cells = [(label, thesis if isinstance(thesis, str) else format(thesis, fmt),
+              ours if isinstance(ours, str) else format(ours, fmt)) for label, thesis, ours, fmt in rows]
+    w0 = max(len(c[0]) for c in cells)
+    w1 = max(6, *(len(c[1]) for c in cells)) + 2
+    w2 = max(7, *(len(c[2]) for c in cells)) + 2
+    lines = [f"{'':<{w0}}{'thesis':>{w1}}{'hunting':>{w2}}"] + [f"{a:<{w0}}{b:>{w1}}{c:>{w2}}" for a, b, c in cells]
     text = (title + "\n" if title else "") + "\n".join(lines)
     pos = {"lower right": (0.98, 0.03, "right", "bottom"), "upper right": (0.98, 0.97, "right", "top"),
            "lower left": (0.02, 0.03, "left", "bottom"), "upper left": (0.02, 0.97, "left", "top"),

@@ -100,6 +100,7 @@ BAD = [
     ("continue table9.1 --param P --from 10 --to 12 --set P=3", "also given in --set"),
     ("continue table9.1 --param D --from -1 --to 1", "D = -1.0 is not allowed"),
     ("continue table9.1 --param P --from 10 --to 12 --plot /nonexistent/b.png", "does not exist"),
+    ("continue table9.1 --param P --from 10 --to 12 --json /nonexistent/b.json", "does not exist"),
     # reproduce and demo
     ("reproduce ch7", "invalid choice: 'ch7'"),
     ("reproduce ch9 --out /proc/nope", "--out '/proc/nope'"),
@@ -111,6 +112,7 @@ BAD = [
     ("diagnose {tmp}/data.csv --model {tmp}/model.json --json {tmp}/data.csv", "same path as DATA"),
     ("diagnose {tmp}/data.csv --model {tmp}/model.json --report /proc/nope", "--report '/proc/nope'"),
     ("diagnose {tmp}/data.csv --model {tmp}/model.json --validate {tmp}", "--validate"),
+    ("diagnose {tmp}/data.csv --model {tmp}/model.json --json /nonexistent/d.json", "does not exist"),
     # the command itself
     ("", "required: COMMAND"),
     ("frobnicate", "invalid choice: 'frobnicate'"),
@@ -124,6 +126,18 @@ def test_bad_input_is_one_line_and_exit_2(capsys, files, argv, expected):
     line = one_line_error(err)
     assert code == 2, line
     assert expected.format(tmp=files) in line
+
+
+def test_diagnose_failures_inside_the_command_are_one_line(capsys, files):
+    """--drop u and a ragged CSV (the diagnosis' own messages may change; the boundary keeps
+    them to one line without a traceback)."""
+    (files / "model.json").write_text(json.dumps({"plant": {"mass": 95.0, "motor_constant": 35.15},
+                                                  "friction": {"law": "coulomb-viscous", "Fc": 20.0, "b": 200.0}}))
+    (files / "ragged.csv").write_text("t,q,u\n0,0,0\n0.001,0\n0.002,0,0,5\n")
+    for argv in (f"diagnose {files}/data.csv --model {files}/model.json --drop u",
+                 f"diagnose {files}/ragged.csv --model {files}/model.json"):
+        code, _, err = run_main(capsys, argv.split())
+        assert code in (1, 2) and one_line_error(err)
 
 
 def test_at_least_forty_bad_inputs_are_covered():

@@ -226,6 +226,10 @@ def test_slope_at_the_origin_is_the_thesis_value_and_decides_stability():
     assert disc.method == "probes" and disc.behaviour == "discontinuous" and not disc.stable
     # an unstable linear loop: the linearized slip never returns to stick, the slope is unbounded
     assert origin_slope(hunting.preset("table9.1", P=-5.0), 2).behaviour == "steep"
+    # the linearized slip decays onto the equilibrium set without returning: P^k(d) = o(d)
+    sw = hunting.preset("table8.1-switch", K=0.2)
+    assert linear_origin(sw, 2).slope_right == 0.0 and origin_slope(sw, 2).stable
+    assert abs(_secant(sw, 1, 1e-5)[0]) < 1e-6
 
 
 # ---------------------------------------------------------------- grids that cannot resolve the map

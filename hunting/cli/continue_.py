@@ -2,8 +2,8 @@
 from __future__ import annotations
 
 from ..errors import SystemDefinitionError
-from .boundary import Output, UsageError, finite_float
-from .systems import add_system_arguments, resolve_system, system_inputs
+from .boundary import UsageError, add_result_arguments, finite_float, result_files
+from .systems import add_system_arguments, resolve_system
 
 NAME = "continue"
 HELP = "follow the hunting branch in one parameter (shooting + arclength)"
@@ -19,12 +19,10 @@ def add_arguments(p) -> None:
                    help="end value of the parameter (different from A)")
     p.add_argument("--back-to", dest="back_to", type=finite_float, default=None, metavar="C",
                    help="after a fold, follow the branch back until the parameter reaches this value")
-    p.add_argument("--json", metavar="FILE", help="the branch as JSON ('-': standard output)")
-    p.add_argument("--plot", metavar="FILE", help="bifurcation diagram and multipliers (png, pdf, svg, ...)")
+    add_result_arguments(p, "the branch", "bifurcation diagram and multipliers")
 
 
-def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], system_inputs(args)
+files = result_files
 
 
 def run(args, results) -> int:

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import sys
 
-from .boundary import Output, UsageError, positive_float, state_spec
-from .systems import add_system_arguments, resolve_system, system_inputs
+from .boundary import UsageError, add_result_arguments, positive_float, result_files, state_spec
+from .systems import add_system_arguments, resolve_system
 
 NAME = "cycle"
 HELP = "find a periodic orbit (hunting cycle): period, multipliers, stick phases"
@@ -27,12 +27,10 @@ def add_arguments(p) -> None:
                         "and scale the transient by it")
     p.add_argument("--which", choices=("stable", "unstable"), default="stable",
                    help="for a preset without --x0: the stable (default) or unstable cycle of its event map")
-    p.add_argument("--json", metavar="FILE", help="the orbit as JSON ('-': standard output)")
-    p.add_argument("--plot", metavar="FILE", help="the orbit with its stick phases shaded (png, pdf, svg, ...)")
+    add_result_arguments(p, "the orbit", "the orbit with its stick phases shaded")
 
 
-def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], system_inputs(args)
+files = result_files
 
 
 def run(args, results) -> int:

@@ -1,8 +1,8 @@
 """``hunting eventmap``: the stick-to-stick map P^k on a grid and its fixed points."""
 from __future__ import annotations
 
-from .boundary import Output, grid, positive_int
-from .systems import add_system_arguments, resolve_system, system_inputs
+from .boundary import add_result_arguments, grid, positive_int, result_files
+from .systems import add_system_arguments, resolve_system
 
 NAME = "eventmap"
 HELP = "stick-to-stick event map and its fixed points"
@@ -14,12 +14,10 @@ def add_arguments(p) -> None:
                    help="stick errors d: N points from START to STOP (e.g. 0:0.5:501)")
     p.add_argument("--iterate", type=positive_int, default=1, metavar="K",
                    help="stick phases per map application (P^K; default 1)")
-    p.add_argument("--json", metavar="FILE", help="map, statuses and fixed points as JSON ('-': standard output)")
-    p.add_argument("--plot", metavar="FILE", help="the map with its fixed points (png, pdf, svg, ...)")
+    add_result_arguments(p, "map, statuses and fixed points", "the map with its fixed points")
 
 
-def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], system_inputs(args)
+files = result_files
 
 
 def run(args, results) -> int:

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .boundary import Output, UsageError, finite_float, positive_float, state_spec
-from .systems import add_system_arguments, resolve_system, system_inputs
+from .boundary import UsageError, add_result_arguments, finite_float, positive_float, result_files, state_spec
+from .systems import add_system_arguments, resolve_system
 
 NAME = "simulate"
 HELP = "simulate a preset or a model"
@@ -20,12 +20,10 @@ def add_arguments(p) -> None:
     p.add_argument("--growth", type=finite_float, default=1e6, metavar="FACTOR",
                    help="end with status DIVERGED when some |x_i| exceeds FACTOR * max(|x0|, 1) "
                         "(default 1e6; 0: no check)")
-    p.add_argument("--json", metavar="FILE", help="trajectory and events as JSON ('-': standard output)")
-    p.add_argument("--plot", metavar="FILE", help="time responses and phase portrait (png, pdf, svg, ...)")
+    add_result_arguments(p, "trajectory and events", "time responses and phase portrait")
 
 
-def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], system_inputs(args)
+files = result_files
 
 
 def run(args, results) -> int:

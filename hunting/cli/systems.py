@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
-from .boundary import Input, UsageError, collect_pairs, name_value
+from .boundary import UsageError, collect_pairs, name_value
 
 log = logging.getLogger("hunting.cli")
 
@@ -58,11 +58,6 @@ def add_system_arguments(p, *, model: bool = True) -> None:
                        "'Your own system') instead of a preset")
     p.add_argument("--set", action="append", type=name_value, metavar="NAME=VALUE", default=[],
                    help="override a parameter (repeatable), e.g. --set P=20 --set beta=1")
-
-
-def system_inputs(args) -> list:
-    """The files the system arguments read (checked before computing)."""
-    return [Input("--model", args.model)] if getattr(args, "model", None) else []
 
 
 def resolve_system(args, *, warn: bool = True, **extra) -> SystemChoice:

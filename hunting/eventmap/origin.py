@@ -93,19 +93,29 @@ def _flow(A: np.ndarray, v0: np.ndarray):
     return z_expm, lam
 
 
-def stick_entry(ls: LinearSlip) -> tuple[float, np.ndarray] | None:
-    """(t* [s], z(t*) (3,)): where the linearized slip velocity z2 first returns to zero, or
-    None when it does not: the search steps by 0.02 / max|lambda| for at most MAX_CHUNKS * CHUNK samples and
-    gives up once |z| has grown by 1e8 (the linearization has left its range)."""
+@dataclass(frozen=True)
+class StickEntry:
+    """How the linearized slip phase ends. kind: "return" (z2 returns to zero at t [s] with
+    state deviation z (3,) per unit d), "decayed" (z decays to 1e-8 of its start without z2
+    returning: the mass creeps onto the equilibrium set and the next stick error is o(d)),
+    "grown" (|z| grows by 1e8 first: the linearization leaves its range, P^k(d)/d is unbounded)
+    or "unknown" (neither within the bounded search)."""
+
+    kind: str
+    t: float | None = None
+    z: np.ndarray | None = None
+
+
+def stick_entry(ls: LinearSlip) -> StickEntry:
+    """Where the linearized slip velocity z2 first returns to zero after break-away. The search
+    steps by 0.02 / max|lambda| for at most MAX_CHUNKS * CHUNK samples."""
     A, v0 = ls.A, ls.v0
     z, lam = _flow(A, v0)
-    if not np.all(np.isfinite(lam)) or np.max(np.abs(lam)) == 0:
-        return None
     start_sign = np.sign((A @ A @ v0)[1])        # z2 ~ (A^2 v0)_2 t^2 / 2 just after break-away
-    if start_sign == 0:
-        return None
+    if not np.all(np.isfinite(lam)) or np.max(np.abs(lam)) == 0 or start_sign == 0:
+        return StickEntry("unknown")
     h = 0.02 / np.max(np.abs(lam))
-    big = 1e8 * np.linalg.norm(v0)
+    size = np.linalg.norm(v0)
 
     def z2(t):
         return float(z(np.array([t]))[0, 1].real)
@@ -116,24 +126,31 @@ def stick_entry(ls: LinearSlip) -> tuple[float, np.ndarray] | None:
             ts = t0 + h * np.arange(1, CHUNK + 1)
             zs = z(ts).real
             flip = np.flatnonzero(np.sign(zs[:, 1]) == -start_sign)
-            grown = np.flatnonzero(~(np.abs(zs).max(axis=1) < big))
-            if grown.size and (not flip.size or grown[0] < flip[0]):
-                return None
-            if flip.size:
-                i = int(flip[0])
+            norm = np.abs(zs).max(axis=1)
+            grown = np.flatnonzero(~(norm < 1e8 * size))
+            small = np.flatnonzero(norm < 1e-8 * size)
+            first = min(a[0] if a.size else CHUNK for a in (flip, grown, small))
+            if first == CHUNK:
+                t0 = float(ts[-1])
+                continue
+            if grown.size and grown[0] == first:
+                return StickEntry("grown")
+            if flip.size and flip[0] == first:
+                i = int(first)
                 lo = ts[i - 1] if i > 0 else 0.5 * ts[0]
                 t_star = float(brentq(z2, lo, ts[i], xtol=1e-15 * ts[i], rtol=4 * np.finfo(float).eps))
-                return t_star, z(np.array([t_star]))[0].real
-            t0 = float(ts[-1])
-    return None
+                return StickEntry("return", t_star, z(np.array([t_star]))[0].real)
+            return StickEntry("decayed")
+    return StickEntry("unknown")
 
 
 @dataclass(frozen=True)
 class LinearOrigin:
     """One-sided slopes of P^k at d = 0 from the linearization.
 
-    slope_right, slope_left : dP^k/dd at 0+ and 0- (inf where the linearized slip never
-    returns to stick and grows: P^k(d)/d is unbounded); first : (P'(0+), P'(0-)); t_stick :
+    slope_right, slope_left : dP^k/dd at 0+ and 0- (inf where the linearized slip grows away
+    without returning to stick: P^k(d)/d is unbounded; 0 where it decays onto the equilibrium
+    set without returning: the next stick error is o(d)); first : (P'(0+), P'(0-)); t_stick :
     (t*-, t*+) [s] (None where there is no return)."""
 
     slope_right: float
@@ -144,27 +161,25 @@ class LinearOrigin:
 
 def linear_origin(loop: ServoLoop, iterate: int) -> LinearOrigin | None:
     """The slopes of P^k at the equilibrium set from :func:`linear_slip`; None when a side is
-    not linearizable or its linearized slip decays without returning to stick (then only the
-    nonlinear terms decide)."""
+    not linearizable or the bounded search cannot tell how its slip phase ends."""
     first, times = {}, {}
     for side, direction in ((+1, -1), (-1, +1)):        # d > 0 slips in x2 < 0, d < 0 in x2 > 0
         ls = linear_slip(loop, direction)
         if ls is None:
             return None
         entry = stick_entry(ls)
-        times[side] = None if entry is None else entry[0]
-        if entry is None:
-            if np.max(np.linalg.eigvals(ls.A).real) > 0:
-                first[side] = np.inf            # grows away without sticking: unbounded slope
-            else:
-                return None
-        else:
-            first[side] = float(entry[1][0])
+        times[side] = entry.t
+        if entry.kind == "unknown":
+            return None
+        first[side] = {"return": lambda: float(entry.z[0]), "grown": lambda: np.inf,
+                       "decayed": lambda: 0.0}[entry.kind]()
 
     def compose(side: int) -> float:
         slope, s = 1.0, side
         for _ in range(int(iterate)):
             step = first[s]
+            if step == 0.0:
+                return 0.0
             slope *= step
             if not np.isfinite(slope):
                 return np.inf
