@@ -6,6 +6,11 @@
                      [--json FILE] [--plot FILE]
     hunting continue PRESET [--set NAME=VALUE ...] --param NAME --from A --to B [--back-to C]
                      [--json FILE] [--plot FILE]
+    hunting cycle PRESET [--set NAME=VALUE ...] [--x0 NAME=V,...] [--period-guess T]
+                     [--which stable|unstable] [--json FILE] [--plot FILE]
+                                        a periodic orbit: period, multipliers, stick phases
+    (simulate, eventmap, continue and cycle take --model FILE, a model description, instead
+    of PRESET)
     hunting reproduce ch8|ch9|ch10 [--out DIR]   a thesis chapter: tables and figures, checked
     hunting demo [--out DIR]            short simulations of chapters 4, 8 and 9, checked
     hunting diagnose DATA --model MODEL.json [--validate DATA2] [--json FILE] [--report DIR]
@@ -33,7 +38,7 @@ import traceback
 from ..errors import ConvergenceError, HuntingError
 from .boundary import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, ArgumentParser, Results, check_files
 
-COMMANDS = ("models", "simulate", "eventmap", "continue_", "reproduce", "demo", "diagnose")
+COMMANDS = ("models", "simulate", "eventmap", "continue_", "cycle", "reproduce", "demo", "diagnose")
 EXIT_BROKEN_PIPE = 141          # what a shell reports for a command ended by SIGPIPE
 
 

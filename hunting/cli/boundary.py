@@ -278,6 +278,19 @@ def check_files(outputs, inputs=()) -> None:
         seen[key] = f"{o.flag} {o.value!r}"
 
 
+def add_result_arguments(p, json_help: str, plot_help: str) -> None:
+    """--json FILE ('-': standard output) and --plot FILE, the results most commands write."""
+    p.add_argument("--json", metavar="FILE", help=f"{json_help} as JSON ('-': standard output)")
+    p.add_argument("--plot", metavar="FILE", help=f"{plot_help} (png, pdf, svg, ...)")
+
+
+def result_files(args):
+    """The outputs of :func:`add_result_arguments` (for a command's ``files``), and the model
+    file of ``--model`` (an input) when the command has one."""
+    inputs = [Input("--model", args.model)] if getattr(args, "model", None) else []
+    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], inputs
+
+
 class Results:
     """Where a command's results go: files replaced atomically, "-" to standard output."""
 

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from ..errors import SystemDefinitionError
-from .boundary import Output, UsageError, finite_float
+from .boundary import UsageError, add_result_arguments, finite_float, result_files
 from .systems import add_system_arguments, resolve_system
 
 NAME = "continue"
@@ -11,19 +11,18 @@ HELP = "follow the hunting branch in one parameter (shooting + arclength)"
 
 def add_arguments(p) -> None:
     add_system_arguments(p)
-    p.add_argument("--param", required=True, help="the parameter to vary (a preset parameter, e.g. K or P)")
+    p.add_argument("--param", required=True, help="the parameter to vary (a preset parameter, e.g. K or P, or a "
+                   "model parameter)")
     p.add_argument("--from", dest="start", type=finite_float, required=True, metavar="A",
                    help="start value of the parameter")
     p.add_argument("--to", dest="end", type=finite_float, required=True, metavar="B",
                    help="end value of the parameter (different from A)")
     p.add_argument("--back-to", dest="back_to", type=finite_float, default=None, metavar="C",
                    help="after a fold, follow the branch back until the parameter reaches this value")
-    p.add_argument("--json", metavar="FILE", help="the branch as JSON ('-': standard output)")
-    p.add_argument("--plot", metavar="FILE", help="bifurcation diagram and multipliers (png, pdf, svg, ...)")
+    add_result_arguments(p, "the branch", "bifurcation diagram and multipliers")
 
 
-def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], []
+files = result_files
 
 
 def run(args, results) -> int:
@@ -39,7 +38,7 @@ def run(args, results) -> int:
         resolve_system(args, warn=False, **{args.param: args.end})
     except SystemDefinitionError as e:
         raise UsageError(f"--param {args.param} --from {args.start:g} --to {args.end:g}: {e}") from None
-    br = follow(choice.preset, args.param, args.start, args.end, overrides=choice.overrides,
+    br = follow(choice.source, args.param, args.start, args.end, params=choice.params,
                 stop_at=args.back_to if args.back_to is not None else args.start)
     print(f"{len(br.mu)} points, {br.message}")
     for s in br.special:
@@ -47,5 +46,5 @@ def run(args, results) -> int:
     if args.json:
         results.write_json(args.json, br.as_dict(), indent=1)
     if args.plot:
-        plot_branch(br, title=f"{choice.preset}: hunting branch in {args.param}", path=args.plot)
-    return 0
+        plot_branch(br, title=f"{choice.preset or choice.model.name}: hunting branch in {args.param}", path=args.plot)
+    return 0 if br.status.ok or len(br.mu) else 1

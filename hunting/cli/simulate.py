@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .boundary import Output, positive_float, state_spec
+from .boundary import UsageError, add_result_arguments, finite_float, positive_float, result_files, state_spec
 from .systems import add_system_arguments, resolve_system
 
 NAME = "simulate"
-HELP = "simulate a preset"
+HELP = "simulate a preset or a model"
 
 
 def add_arguments(p) -> None:
@@ -17,31 +17,37 @@ def add_arguments(p) -> None:
     p.add_argument("--t", type=positive_float, default=30.0, help="end time [s] (default 30)")
     p.add_argument("--method", default="dop853", choices=("dop853", "dp5", "radau"),
                    help="integration method (radau for stiff LuGre loops)")
-    p.add_argument("--json", metavar="FILE", help="trajectory and events as JSON ('-': standard output)")
-    p.add_argument("--plot", metavar="FILE", help="time responses and phase portrait (png, pdf, svg, ...)")
+    p.add_argument("--growth", type=finite_float, default=1e6, metavar="FACTOR",
+                   help="end with status DIVERGED when some |x_i| exceeds FACTOR * max(|x0|, 1) "
+                        "(default 1e6; 0: no check)")
+    add_result_arguments(p, "trajectory and events", "time responses and phase portrait")
 
 
-def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], []
+files = result_files
 
 
 def run(args, results) -> int:
     from ..integrate import simulate
     from ..plotting import plot_trajectory
     choice = resolve_system(args)
-    loop = choice.loop
-    x0 = args.x0.vector(list(loop.system.state_names)) if args.x0 else np.zeros(loop.n_states)
-    tr = simulate(loop.system, x0, (0.0, args.t), method=args.method)
+    system = choice.system
+    if args.x0:
+        x0 = args.x0.vector(list(system.state_names))
+    else:
+        x0 = choice.model.state() if choice.model is not None else np.zeros(system.n_states)
+    if args.growth != 0 and args.growth <= 1:
+        raise UsageError(f"--growth {args.growth:g} is not allowed: a factor > 1, or 0 for no check")
+    tr = simulate(system, x0, (0.0, args.t), method=args.method, growth=args.growth or None)
     print(tr.summary())
     print(f"events: {len(tr.events)}; final state {np.array2string(tr.x_final, precision=6)}")
     if args.json:
         results.write_json(args.json, {
-            "preset": args.preset, "set": choice.overrides, "warnings": list(choice.warnings),
+            "preset": args.preset, "model": getattr(args, "model", None), "set": choice.overrides, "warnings": list(choice.warnings),
             "status": tr.status.name, "message": tr.message,
             "t": tr.t.tolist(), "x": tr.x.tolist(), "mode": tr.mode.tolist(),
             "events": {"t": tr.events.t.tolist(), "x": tr.events.x_after.tolist(),
                        "mode_from": tr.events.mode_from.tolist(), "mode_to": tr.events.mode_to.tolist()}})
     if args.plot:
-        stick = [loop.stick_mode] if loop.stick_mode is not None else []
-        plot_trajectory(tr, title=choice.label, stick_modes=stick, units=loop.system.units, path=args.plot)
+        stick = system.modes_of_kind("stick")
+        plot_trajectory(tr, title=choice.label, stick_modes=stick, units=system.units, path=args.plot)
     return 0 if tr.success else 1
