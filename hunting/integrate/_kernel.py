@@ -12,9 +12,12 @@ velocity that was just set to zero by a transition -- are *unarmed*: they are sa
 dense output and armed once they have moved away from zero on the non-firing side. An unarmed
 guard that instead moves beyond ``guard_tol`` on the firing side fires at that threshold.
 """
+import warnings
+
 import numba
 import numpy as np
 from numba import types
+from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..errors import Status
 from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE
@@ -72,14 +75,14 @@ def _guards_base(guards, mode, t, y, p, out, xb):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, xb, gs):
-    dense_eval(method, t_old, h, y_old, Q, t, xs)
+def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, xb, gs, full):
+    dense_eval(method, t_old, h, y_old, Q, t, xs, full)
     _guards_base(guards, mode, t, xs, p, gs, xb)
     return gs[i]
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, xb, gs):
+def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, xb, gs, full):
     """Root of g_i(t) + shift on [ta, tb] given opposite signs at the ends (Illinois method
     with bisection safeguard). Returns the right end of the final bracket: the first time at
     which the guard is on its firing side, to within a few ulps of t."""
@@ -98,7 +101,7 @@ def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, meth
             tc = 0.5 * (ta + tb)
         if not (ta < tc < tb):
             tc = 0.5 * (ta + tb)
-        fc = _guard_at(guards, mode, tc, t_old, h, y_old, Q, method, p, i, xs, xb, gs) + shift
+        fc = _guard_at(guards, mode, tc, t_old, h, y_old, Q, method, p, i, xs, xb, gs, full) + shift
         if fc == 0.0:
             return tc
         if (fc > 0.0) == (fb > 0.0):
@@ -139,7 +142,7 @@ def _fires(d, ga, gb, shift_a_to_b):
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, xb, gs):
+def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, xb, gs, full):
     """Scan an unarmed guard over one step. Returns (event time or inf, armed at the end);
     an event found while still unarmed is a threshold event (armed False)."""
     ta = t
@@ -151,19 +154,19 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
             gb = g1
         else:
             tb = t + h * k / (N_SAMPLES + 1)
-            gb = _guard_at(guards, mode, tb, t, h, y_old, Q, method, p, i, xs, xb, gs)
+            gb = _guard_at(guards, mode, tb, t, h, y_old, Q, method, p, i, xs, xb, gs, full)
         if armed:
             if _fires(d, ga, gb, 0.0):
                 return locate_root(guards, mode, i, 0.0, ta, ga, tb, gb, t, h, y_old, Q, method, p,
-                                   xs, xb, gs), True
+                                   xs, xb, gs, full), True
         else:
             # beyond the tolerance band on the firing side: fire at the band's edge
             if d <= 0 and gb < -tol and ga + tol >= 0.0:
                 return locate_root(guards, mode, i, tol, ta, ga, tb, gb, t, h, y_old, Q, method, p,
-                                   xs, xb, gs), False
+                                   xs, xb, gs, full), False
             if d >= 0 and gb > tol and ga - tol <= 0.0:
                 return locate_root(guards, mode, i, -tol, ta, ga, tb, gb, t, h, y_old, Q, method, p,
-                                   xs, xb, gs), False
+                                   xs, xb, gs, full), False
             if _armed_state(d, gb, tol):
                 armed = True
         ta = tb
@@ -172,21 +175,30 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
+def _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp, y_new, f_new,
+              err, full):
+    """One explicit step (see explicit_step): the one copy of the stepper, called by the main
+    loop and by event polishing (inlined into both, it doubled the kernel's compile time)."""
+    return explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
+                         y_new, f_new, err, full)
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr,
-             Z, F3, R, K, ytmp, y_new, f_new, err):
+             Z, F3, R, K, ytmp, y_new, f_new, err, full):
     """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
-    if method == METHOD_RADAU:
+    if full is not None and method == METHOD_RADAU:
         en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, J, M, piv,
-                                  Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
+                                  Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err, full)
         return conv, fe
-    explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new,
-                  f_new, err)
+    _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new,
+              f_new, err, full)
     return True, 12 if method == METHOD_DOP853 else 6
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol,
-                  J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, xb, gs):
+                  J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, xb, gs, full):
     """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
     On success xs holds the state at the returned event time; otherwise xs is left as the
     dense-output state and t_ev is returned unchanged. Returns (t_ev, f evaluations)."""
@@ -194,8 +206,8 @@ def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method,
     delta = 1e-7 * h
     ta = max(t, t_ev - delta)
     tb = min(t + h, t_ev + delta)
-    ga = _guard_at(guards, mode, ta, t, h, x, Q, method, p, i_ev, ytmp, xb, gs)
-    gb = _guard_at(guards, mode, tb, t, h, x, Q, method, p, i_ev, ytmp, xb, gs)
+    ga = _guard_at(guards, mode, ta, t, h, x, Q, method, p, i_ev, ytmp, xb, gs, full)
+    gb = _guard_at(guards, mode, tb, t, h, x, Q, method, p, i_ev, ytmp, xb, gs, full)
     if tb <= ta or ga == gb:
         return t_ev, 0
     slope = (gb - ga) / (tb - ta)
@@ -203,7 +215,7 @@ def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method,
     nfev = 0
     for it in range(4):
         ok, fe = _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv,
-                          Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err)
+                          Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, full)
         nfev += fe
         if not ok:
             return t_ev, nfev
@@ -316,435 +328,494 @@ def workspace_sizes(n, nb, ng, n_modes, zeno_count):
     return nf, 4 * n + ng
 
 
-@numba.njit(KERNEL_SIG, cache=True, error_model="numpy", _nrt=False)
-def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
-                     t0, t1, x0, mode0, p, dpw, directions,
-                     rtol, atol, h0, hmax, max_steps, max_events, guard_tol, fixed,
-                     t_eval, record_steps, stop_mode, stop_count, zeno_count, zeno_window,
-                     out_t, out_x, out_mode,
-                     ev_t, ev_xb, ev_xa, ev_guard, ev_from, ev_to,
-                     info, finfo, x_final, wf, wi):
-    """Integrate from (t0, x0, mode0) towards t1; see the module docstring.
+def _make_kernel(full_flag):
+    """The kernel body as a closure over ``FULL`` (None: lean, True: full). numba prunes
+    branches on closure constants before typing and keys its disk cache on their values, so
+    both kernels come from this one source and are cached side by side. (An inlined body shared
+    by two entries does not work: calls with more than 30 arguments compile to f(*args), which
+    numba cannot inline.)"""
+    FULL = full_flag
 
-    Inputs: ``mode0 < 0`` asks ``mode_of``; ``h0 <= 0`` selects the first step; ``fixed``
-    takes steps of h0 without error control (convergence studies; rtol/atol then only set the
-    Newton tolerance of the implicit method); ``t_eval``
-    (sorted, within [t0, t1]) or, when empty, every accepted step and both sides of each event
-    are recorded if ``record_steps``. ``stop_mode >= 0`` stops on the ``stop_count``-th entry
-    into that mode (counted from ``info[I_STOPHITS]``). ``info[I_IEVAL]`` is the next t_eval
-    index, ``info[I_NEVTOT]`` the events so far (both carried across resumes).
+    def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
+                         t0, t1, x0, mode0, p, dpw, directions,
+                         rtol, atol, h0, hmax, max_steps, max_events, guard_tol, fixed,
+                         t_eval, record_steps, stop_mode, stop_count, zeno_count, zeno_window,
+                         out_t, out_x, out_mode,
+                         ev_t, ev_xb, ev_xa, ev_guard, ev_from, ev_to,
+                         info, finfo, x_final, wf, wi):
+        """Integrate from (t0, x0, mode0) towards t1; see the module docstring.
 
-    ``nb < x0.size`` integrates sensitivities: x0 = [x (nb), Phi0 row-major (nb * m)], the
-    variational equations ride along (part of the explicit methods' error control; Radau
-    differentiates its collocation solution exactly and controls x only) and every event multiplies Phi
-    by its saltation matrix. Guards, transitions and mode_of always see the base state only.
-    With m = nb + 1 the last column is the sensitivity to a parameter mu along the direction
-    dpw[0] = dp/dmu (dpw (2, len(p)), row 1 scratch): psi' = J psi + f_mu, and at events
-    psi+ = S psi + jump g_mu + R_mu; otherwise m = nb and dpw may be NO_PARAM_DIRECTION.
+        Inputs: ``mode0 < 0`` asks ``mode_of``; ``h0 <= 0`` selects the first step; ``fixed``
+        takes steps of h0 without error control (convergence studies; rtol/atol then only set the
+        Newton tolerance of the implicit method); ``t_eval``
+        (sorted, within [t0, t1]) or, when empty, every accepted step and both sides of each event
+        are recorded if ``record_steps``. ``stop_mode >= 0`` stops on the ``stop_count``-th entry
+        into that mode (counted from ``info[I_STOPHITS]``). ``info[I_IEVAL]`` is the next t_eval
+        index, ``info[I_NEVTOT]`` the events so far (both carried across resumes).
 
-    Outputs: info (status, counts, final mode), finfo (final t, last step), x_final, and the
-    buffers out_* (points, all n columns) and ev_* (event time, base state before/after, guard,
-    modes). wf, wi: float and int workspaces of at least workspace_sizes(...) entries."""
-    n = x0.size
-    n_modes = directions.shape[0]
-    ng = directions.shape[1]
-    cap_out = out_t.size
-    cap_ev = ev_t.size
-    n_eval = t_eval.size
-    use_eval = n_eval > 0
+        ``nb < x0.size`` integrates sensitivities: x0 = [x (nb), Phi0 row-major (nb * m)], the
+        variational equations ride along (part of the explicit methods' error control; Radau
+        differentiates its collocation solution exactly and controls x only) and every event multiplies Phi
+        by its saltation matrix. Guards, transitions and mode_of always see the base state only.
+        With m = nb + 1 the last column is the sensitivity to a parameter mu along the direction
+        dpw[0] = dp/dmu (dpw (2, len(p)), row 1 scratch): psi' = J psi + f_mu, and at events
+        psi+ = S psi + jump g_mu + R_mu; otherwise m = nb and dpw may be NO_PARAM_DIRECTION.
 
-    # every work array is carved out of the caller's workspace (see workspace_sizes): the kernel
-    # allocates nothing, runs without reference counting (_nrt=False) and its helpers inline
-    o = 0
-    x = wf[o:o + n]
-    o += n
-    xb = wf[o:o + nb]
-    o += nb
-    xb2 = wf[o:o + nb]
-    o += nb
-    f = wf[o:o + n]
-    o += n
-    y_new = wf[o:o + n]
-    o += n
-    f_new = wf[o:o + n]
-    o += n
-    ytmp = wf[o:o + n]
-    o += n
-    ftmp = wf[o:o + n]
-    o += n
-    err = wf[o:o + n]
-    o += n
-    xs = wf[o:o + n]
-    o += n
-    K = wf[o:o + 16 * n].reshape((16, n))
-    o += 16 * n
-    Q = wf[o:o + 7 * n].reshape((7, n))
-    o += 7 * n
-    J = wf[o:o + n * n].reshape((n, n))
-    o += n * n
-    M = wf[o:o + 9 * n * n].reshape((3 * n, 3 * n))
-    o += 9 * n * n
-    Mr = wf[o:o + n * n].reshape((n, n))
-    o += n * n
-    Z = wf[o:o + 3 * n].reshape((3, n))
-    o += 3 * n
-    F3 = wf[o:o + 3 * n].reshape((3, n))
-    o += 3 * n
-    R = wf[o:o + 3 * n]
-    o += 3 * n
-    g_old = wf[o:o + ng]
-    o += ng
-    g_new = wf[o:o + ng]
-    o += ng
-    gs = wf[o:o + ng]
-    o += ng
-    nz = max(zeno_count, 1)
-    zeno_times = wf[o:o + nz]
-    o += nz
-    # last error-controlled step size per mode: re-entering a mode starts from it instead of
-    # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
-    h_mode = wf[o:o + n_modes]
-    o += n_modes
-    yw = wf[o:o + nb]
-    o += nb
-    fw = wf[o:o + nb]
-    o += nb
-    fp = wf[o:o + nb]
-    o += nb
-    fm = wf[o:o + nb]
-    o += nb
-    fbm = wf[o:o + nb]
-    o += nb
-    fbp = wf[o:o + nb]
-    o += nb
-    gradh = wf[o:o + nb]
-    o += nb
-    xw = wf[o:o + nb]
-    o += nb
-    xw2 = wf[o:o + nb]
-    o += nb
-    Jw = wf[o:o + nb * nb].reshape((nb, nb))
-    o += nb * nb
-    Ssal = wf[o:o + nb * nb].reshape((nb, nb))
-    o += nb * nb
-    Rx = wf[o:o + nb * nb].reshape((nb, nb))
-    piv = wi[0:3 * n]
-    pivr = wi[3 * n:4 * n]
-    armed = wi[4 * n:4 * n + ng]
-    for i in range(nz):
-        zeno_times[i] = -np.inf
-    for i in range(n_modes):
-        h_mode[i] = np.inf
-    for i in range(7):
-        for j in range(n):
-            Q[i, j] = 0.0
-    sens = nb < n
-    m_sens = (n - nb) // nb          # columns of Phi: nb, or nb + 1 with the parameter column
+        Outputs: info (status, counts, final mode), finfo (final t, last step), x_final, and the
+        buffers out_* (points, all n columns) and ev_* (event time, base state before/after, guard,
+        modes). wf, wi: float and int workspaces of at least workspace_sizes(...) entries."""
+        # None: the lean kernel (every `full is not None` branch is pruned before typing, down to
+        # the steppers and helpers, which are typed with a NoneType argument); True: the full one
+        full = FULL
+        n = x0.size
+        n_modes = directions.shape[0]
+        ng = directions.shape[1]
+        cap_out = out_t.size
+        cap_ev = ev_t.size
+        n_eval = t_eval.size
+        use_eval = n_eval > 0
 
-    for i in range(n):
-        x[i] = x0[i]
-    t = t0
-    mode = mode0
-    for i in range(nb):
-        xb[i] = x[i]
-    if mode < 0:
-        mode = mode_of(t, xb, p)
-    if mode < 0 or mode >= n_modes:
-        info[I_STATUS] = _S_INVALID
-        info[I_MODE] = mode
-        finfo[F_T] = t
-        _put(x_final, x)
-        return
+        # every work array is carved out of the caller's workspace (see workspace_sizes): the kernel
+        # allocates nothing, runs without reference counting (_nrt=False) and its helpers inline
+        o = 0
+        x = wf[o:o + n]
+        o += n
+        xb = wf[o:o + nb]
+        o += nb
+        xb2 = wf[o:o + nb]
+        o += nb
+        f = wf[o:o + n]
+        o += n
+        y_new = wf[o:o + n]
+        o += n
+        f_new = wf[o:o + n]
+        o += n
+        ytmp = wf[o:o + n]
+        o += n
+        ftmp = wf[o:o + n]
+        o += n
+        err = wf[o:o + n]
+        o += n
+        xs = wf[o:o + n]
+        o += n
+        K = wf[o:o + 16 * n].reshape((16, n))
+        o += 16 * n
+        Q = wf[o:o + 7 * n].reshape((7, n))
+        o += 7 * n
+        J = wf[o:o + n * n].reshape((n, n))
+        o += n * n
+        M = wf[o:o + 9 * n * n].reshape((3 * n, 3 * n))
+        o += 9 * n * n
+        Mr = wf[o:o + n * n].reshape((n, n))
+        o += n * n
+        Z = wf[o:o + 3 * n].reshape((3, n))
+        o += 3 * n
+        F3 = wf[o:o + 3 * n].reshape((3, n))
+        o += 3 * n
+        R = wf[o:o + 3 * n]
+        o += 3 * n
+        g_old = wf[o:o + ng]
+        o += ng
+        g_new = wf[o:o + ng]
+        o += ng
+        gs = wf[o:o + ng]
+        o += ng
+        nz = max(zeno_count, 1)
+        zeno_times = wf[o:o + nz]
+        o += nz
+        # last error-controlled step size per mode: re-entering a mode starts from it instead of
+        # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
+        h_mode = wf[o:o + n_modes]
+        o += n_modes
+        yw = wf[o:o + nb]
+        o += nb
+        fw = wf[o:o + nb]
+        o += nb
+        fp = wf[o:o + nb]
+        o += nb
+        fm = wf[o:o + nb]
+        o += nb
+        fbm = wf[o:o + nb]
+        o += nb
+        fbp = wf[o:o + nb]
+        o += nb
+        gradh = wf[o:o + nb]
+        o += nb
+        xw = wf[o:o + nb]
+        o += nb
+        xw2 = wf[o:o + nb]
+        o += nb
+        Jw = wf[o:o + nb * nb].reshape((nb, nb))
+        o += nb * nb
+        Ssal = wf[o:o + nb * nb].reshape((nb, nb))
+        o += nb * nb
+        Rx = wf[o:o + nb * nb].reshape((nb, nb))
+        piv = wi[0:3 * n]
+        pivr = wi[3 * n:4 * n]
+        armed = wi[4 * n:4 * n + ng]
+        for i in range(nz):
+            zeno_times[i] = -np.inf
+        for i in range(n_modes):
+            h_mode[i] = np.inf
+        for i in range(7):
+            for j in range(n):
+                Q[i, j] = 0.0
+        sens = nb < n
+        m_sens = (n - nb) // nb          # columns of Phi: nb, or nb + 1 with the parameter column
 
-    n_threshold = 0   # consecutive events of guards that never left their tolerance band
-
-    n_out = info[I_NOUT]
-    n_ev = info[I_NEV]
-    n_ev_total = info[I_NEVTOT]
-    stop_hits = info[I_STOPHITS]
-    i_eval = info[I_IEVAL]
-    n_steps = 0
-    n_rej = 0
-    nfev = 0
-    njac = 0
-    order = 8 if method == METHOD_DOP853 else 5
-    expo = -1.0 / 8.0 if method == METHOD_DOP853 else (-1.0 / 5.0 if method == METHOD_DP5 else -0.25)
-    status = _S_SUCCESS
-
-    nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f)
-    _guards_base(guards, mode, t, x, p, g_old, xb)
-    for i in range(ng):
-        armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
-
-    if record_steps and not use_eval and n_out == 0:
-        out_t[0] = t
-        _put_row(out_x, 0, x)
-        out_mode[0] = mode
-        n_out = 1
-    while use_eval and i_eval < n_eval and t_eval[i_eval] <= t:
-        if t_eval[i_eval] == t:
-            out_t[n_out] = t
-            _put_row(out_x, n_out, x)
-            out_mode[n_out] = mode
-            n_out += 1
-        i_eval += 1
-
-    if h0 > 0.0:
-        h = h0
-    else:
-        h = select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, p, max(t1 - t, 1e-300), order,
-                                rtol, atol, ytmp, ftmp)
-        nfev += 1
-    n_small = 0
-    rejected = False
-    while True:
-        remaining = t1 - t
-        if remaining <= 0.0:
-            status = _S_SUCCESS
-            break
-        if n_steps + n_rej >= max_steps:
-            status = _S_MAXSTEPS
-            break
-        if (not use_eval) and record_steps and cap_out - n_out < 3:
-            status = _S_FULL
-            break
-        if n_ev >= cap_ev:
-            status = _S_FULL
-            break
-        tiny = 8.0 * EPS * max(abs(t), 1e-300)
-        if h > hmax:
-            h = hmax
-        last = False
-        if h >= remaining - tiny:
-            h = remaining
-            last = True
-        if h <= tiny and not last:
-            status = _S_SMALL
-            break
-        if method == METHOD_RADAU:
-            if not sens:
-                if has_jac:
-                    jac(mode, t, x, p, J)
-                else:
-                    numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
-                    nfev += n
-            else:
-                # J_x into J's leading block: radau_step solves the variational stages with the
-                # stage Jacobians itself
-                for i in range(nb):
-                    xw[i] = x[i]
-                nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, J, fbm, fbp, nb)
-            njac += 1
-            en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
-                                      Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err)
-            nfev += fe
-            if not conv:
-                n_rej += 1
-                h *= 0.5
-                if h <= tiny:
-                    status = _S_NEWTON
-                    break
-                continue
-        else:
-            en = explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
-                               y_new, f_new, err)
-            nfev += 12 if method == METHOD_DOP853 else 6
-        finite = np.isfinite(en)
         for i in range(n):
-            if not np.isfinite(y_new[i]) or not np.isfinite(f_new[i]):
-                finite = False
-        if not finite:
-            n_rej += 1
-            n_small += 1
-            h *= 0.25
-            if h <= tiny or n_small > 60:
-                status = _S_NONFINITE
+            x[i] = x0[i]
+        t = t0
+        mode = mode0
+        for i in range(nb):
+            xb[i] = x[i]
+        if mode < 0:
+            mode = mode_of(t, xb, p)
+        if mode < 0 or mode >= n_modes:
+            info[I_STATUS] = _S_INVALID
+            info[I_MODE] = mode
+            finfo[F_T] = t
+            _put(x_final, x)
+            return
+
+        n_threshold = 0   # consecutive events of guards that never left their tolerance band
+
+        n_out = info[I_NOUT]
+        n_ev = info[I_NEV]
+        n_ev_total = info[I_NEVTOT]
+        stop_hits = info[I_STOPHITS]
+        i_eval = info[I_IEVAL]
+        n_steps = 0
+        n_rej = 0
+        nfev = 0
+        njac = 0
+        order = 8 if method == METHOD_DOP853 else 5
+        expo = -1.0 / 8.0 if method == METHOD_DOP853 else (-1.0 / 5.0 if method == METHOD_DP5 else -0.25)
+        status = _S_SUCCESS
+
+        nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f, full)
+        _guards_base(guards, mode, t, x, p, g_old, xb)
+        for i in range(ng):
+            armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
+
+        if record_steps and not use_eval and n_out == 0:
+            out_t[0] = t
+            _put_row(out_x, 0, x)
+            out_mode[0] = mode
+            n_out = 1
+        while use_eval and i_eval < n_eval and t_eval[i_eval] <= t:
+            if t_eval[i_eval] == t:
+                out_t[n_out] = t
+                _put_row(out_x, n_out, x)
+                out_mode[n_out] = mode
+                n_out += 1
+            i_eval += 1
+
+        if h0 > 0.0:
+            h = h0
+        else:
+            h = select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, p, max(t1 - t, 1e-300), order,
+                                    rtol, atol, ytmp, ftmp, full)
+            nfev += 1
+        n_small = 0
+        rejected = False
+        while True:
+            remaining = t1 - t
+            if remaining <= 0.0:
+                status = _S_SUCCESS
                 break
-            continue
-        if fixed:
-            en = 0.0
-        if en > 1.0:
-            n_rej += 1
-            rejected = True
-            h *= max(MIN_FACTOR, SAFETY * en ** expo)
-            if h <= tiny:
+            if n_steps + n_rej >= max_steps:
+                status = _S_MAXSTEPS
+                break
+            if (not use_eval) and record_steps and cap_out - n_out < 3:
+                status = _S_FULL
+                break
+            if n_ev >= cap_ev:
+                status = _S_FULL
+                break
+            tiny = 8.0 * EPS * max(abs(t), 1e-300)
+            if h > hmax:
+                h = hmax
+            last = False
+            if h >= remaining - tiny:
+                h = remaining
+                last = True
+            if h <= tiny and not last:
                 status = _S_SMALL
                 break
-            continue
-        n_small = 0
-        n_steps += 1
-        t_new = t1 if last else t + h
-        # ---- events on this step; dense output only when a guard or t_eval needs it
-        _guards_base(guards, mode, t_new, y_new, p, g_new, xb)
-        need_dense = use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new
-        for i in range(ng):
-            if (not armed[i]) or _fires(directions[mode, i], g_old[i], g_new[i], 0.0):
-                need_dense = True
-        if method == METHOD_RADAU:
-            radau_dense(Z, Q)
-        elif need_dense:
-            nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, y_new, f_new, h, p, K, ytmp, Q)
-        t_ev = np.inf
-        i_ev = -1
-        ev_exact = True   # False for threshold events of unarmed guards (no polishing)
-        for i in range(ng):
-            d = directions[mode, i]
-            if armed[i]:
-                if _fires(d, g_old[i], g_new[i], 0.0):
-                    tr = locate_root(guards, mode, i, 0.0, t, g_old[i], t_new, g_new[i], t, h, x, Q,
-                                     method, p, xs, xb, gs)
+            if full is not None and method == METHOD_RADAU:
+                if not sens:
+                    if has_jac:
+                        jac(mode, t, x, p, J)
+                    else:
+                        numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
+                        nfev += n
+                else:
+                    # J_x into J's leading block: radau_step solves the variational stages with the
+                    # stage Jacobians itself
+                    for i in range(nb):
+                        xw[i] = x[i]
+                    nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, J, fbm, fbp, nb)
+                njac += 1
+                en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
+                                          Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err, full)
+                nfev += fe
+                if not conv:
+                    n_rej += 1
+                    h *= 0.5
+                    if h <= tiny:
+                        status = _S_NEWTON
+                        break
+                    continue
+            else:
+                en = _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
+                               y_new, f_new, err, full)
+                nfev += 12 if method == METHOD_DOP853 else 6
+            finite = np.isfinite(en)
+            for i in range(n):
+                if not np.isfinite(y_new[i]) or not np.isfinite(f_new[i]):
+                    finite = False
+            if not finite:
+                n_rej += 1
+                n_small += 1
+                h *= 0.25
+                if h <= tiny or n_small > 60:
+                    status = _S_NONFINITE
+                    break
+                continue
+            if fixed:
+                en = 0.0
+            if en > 1.0:
+                n_rej += 1
+                rejected = True
+                h *= max(MIN_FACTOR, SAFETY * en ** expo)
+                if h <= tiny:
+                    status = _S_SMALL
+                    break
+                continue
+            n_small = 0
+            n_steps += 1
+            t_new = t1 if last else t + h
+            # ---- events on this step; dense output only when a guard or t_eval needs it
+            _guards_base(guards, mode, t_new, y_new, p, g_new, xb)
+            need_dense = use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new
+            for i in range(ng):
+                if (not armed[i]) or _fires(directions[mode, i], g_old[i], g_new[i], 0.0):
+                    need_dense = True
+            if full is not None and method == METHOD_RADAU:
+                radau_dense(Z, Q)
+            elif need_dense:
+                nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, y_new, f_new, h, p, K, ytmp, Q,
+                                       full)
+            t_ev = np.inf
+            i_ev = ng - ng - 1   # -1, typed int64 (a literal -1 made numba compile _polish_event twice)
+            ev_exact = True   # False for threshold events of unarmed guards (no polishing)
+            for i in range(ng):
+                d = directions[mode, i]
+                if armed[i]:
+                    if _fires(d, g_old[i], g_new[i], 0.0):
+                        tr = locate_root(guards, mode, i, 0.0, t, g_old[i], t_new, g_new[i], t, h, x, Q,
+                                         method, p, xs, xb, gs, full)
+                        if tr < t_ev:
+                            t_ev = tr
+                            i_ev = i
+                            ev_exact = True
+                else:
+                    tr, arm_end = _scan_unarmed(guards, mode, i, d, guard_tol, t, g_old[i], t_new,
+                                                g_new[i], h, x, Q, method, p, xs, xb, gs, full)
                     if tr < t_ev:
                         t_ev = tr
                         i_ev = i
-                        ev_exact = True
-            else:
-                tr, arm_end = _scan_unarmed(guards, mode, i, d, guard_tol, t, g_old[i], t_new,
-                                            g_new[i], h, x, Q, method, p, xs, xb, gs)
-                if tr < t_ev:
-                    t_ev = tr
-                    i_ev = i
-                    ev_exact = arm_end
-                armed[i] = arm_end
-        if i_ev >= 0:
-            # output up to the event
-            while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_ev:
-                dense_eval(method, t, h, x, Q, t_eval[i_eval], xs)
+                        ev_exact = arm_end
+                    armed[i] = arm_end
+            if i_ev >= 0:
+                # output up to the event
+                while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_ev:
+                    dense_eval(method, t, h, x, Q, t_eval[i_eval], xs, full)
+                    out_t[n_out] = t_eval[i_eval]
+                    _put_row(out_x, n_out, xs)
+                    out_mode[n_out] = mode
+                    n_out += 1
+                    i_eval += 1
+                dense_eval(method, t, h, x, Q, t_ev, xs, full)
+                if ev_exact and t_ev > t:
+                    # polish: integrate to the event with one step of the method itself, so the
+                    # event state has the method's order rather than its dense output's
+                    t_ev, fe = _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h,
+                                             t_ev, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
+                                             y_new, f_new, err, Q, xs, xb, gs, full)
+                    nfev += fe
+                for i in range(nb):
+                    xb[i] = xs[i]
+                new_mode = reset(mode, i_ev, t_ev, xb, p, xb2)
+                for i in range(nb):
+                    ytmp[i] = xb2[i]
+                if full is not None and sens and 0 <= new_mode < n_modes:
+                    saltation(vf, guards, reset, mode, new_mode, i_ev, t_ev, xb, xb2, p, Ssal, fbm, fbp,
+                              gradh, xw, xw2, gs, Rx)
+                    nfev += 2
+                    for i in range(nb):
+                        for j in range(m_sens):
+                            acc = 0.0
+                            for k in range(nb):
+                                acc += Ssal[i, k] * xs[nb + k * m_sens + j]
+                            ytmp[nb + i * m_sens + j] = acc
+                    if m_sens > nb:
+                        # the event time moves with mu through g_mu; the reset moves with R_mu
+                        saltation_param(guards, reset, mode, i_ev, t_ev, xb, p, dpw, gs, xw2, fbm)
+                        for i in range(nb):
+                            ytmp[nb + i * m_sens + nb] += fbp[i] * gs[0] + fbm[i]
+                elif full is not None and sens:
+                    for i in range(nb, n):
+                        ytmp[i] = xs[i]
+                ev_t[n_ev] = t_ev
+                _put_row(ev_xb, n_ev, xb)
+                _put_row(ev_xa, n_ev, xb2)
+                ev_guard[n_ev] = i_ev
+                ev_from[n_ev] = mode
+                ev_to[n_ev] = new_mode
+                n_ev += 1
+                n_ev_total += 1
+                if record_steps and not use_eval:
+                    out_t[n_out] = t_ev
+                    _put_row(out_x, n_out, xs)
+                    out_mode[n_out] = mode
+                    n_out += 1
+                t = t_ev
+                for i in range(n):
+                    x[i] = ytmp[i]
+                if new_mode < 0:
+                    status = _S_STOPPED
+                    break
+                if new_mode >= n_modes:
+                    status = _S_INVALID
+                    mode = new_mode
+                    break
+                mode = new_mode
+                if record_steps and not use_eval:
+                    out_t[n_out] = t
+                    _put_row(out_x, n_out, x)
+                    out_mode[n_out] = mode
+                    n_out += 1
+                # Zeno: zeno_count events within zeno_window, or zeno_count consecutive events of
+                # guards that never armed (the motion chatters inside the guard tolerance)
+                n_threshold = 0 if ev_exact else n_threshold + 1
+                if zeno_count > 0 and n_threshold >= zeno_count:
+                    status = _S_ZENO
+                    break
+                if zeno_count > 0:
+                    k = n_ev_total % zeno_count
+                    if t - zeno_times[k] < zeno_window:
+                        status = _S_ZENO
+                        break
+                    zeno_times[k] = t
+                if stop_mode >= 0 and mode == stop_mode:
+                    stop_hits += 1
+                    if stop_hits >= stop_count:
+                        status = _S_STOPPED
+                        break
+                if n_ev_total >= max_events:
+                    status = _S_MAXEVENTS
+                    break
+                nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f, full)
+                _guards_base(guards, mode, t, x, p, g_old, xb)
+                for i in range(ng):
+                    armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
+                if fixed:
+                    h = h0
+                else:
+                    h = min(h, h_mode[mode])
+                continue
+            # ---- no event: accept the whole step
+            while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new:
+                dense_eval(method, t, h, x, Q, t_eval[i_eval], xs, full)
                 out_t[n_out] = t_eval[i_eval]
                 _put_row(out_x, n_out, xs)
                 out_mode[n_out] = mode
                 n_out += 1
                 i_eval += 1
-            dense_eval(method, t, h, x, Q, t_ev, xs)
-            if ev_exact and t_ev > t:
-                # polish: integrate to the event with one step of the method itself, so the
-                # event state has the method's order rather than its dense output's
-                t_ev, fe = _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h,
-                                         t_ev, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
-                                         y_new, f_new, err, Q, xs, xb, gs)
-                nfev += fe
-            for i in range(nb):
-                xb[i] = xs[i]
-            new_mode = reset(mode, i_ev, t_ev, xb, p, xb2)
-            for i in range(nb):
-                ytmp[i] = xb2[i]
-            if sens and 0 <= new_mode < n_modes:
-                saltation(vf, guards, reset, mode, new_mode, i_ev, t_ev, xb, xb2, p, Ssal, fbm, fbp,
-                          gradh, xw, xw2, gs, Rx)
-                nfev += 2
-                for i in range(nb):
-                    for j in range(m_sens):
-                        acc = 0.0
-                        for k in range(nb):
-                            acc += Ssal[i, k] * xs[nb + k * m_sens + j]
-                        ytmp[nb + i * m_sens + j] = acc
-                if m_sens > nb:
-                    # the event time moves with mu through g_mu; the reset moves with R_mu
-                    saltation_param(guards, reset, mode, i_ev, t_ev, xb, p, dpw, gs, xw2, fbm)
-                    for i in range(nb):
-                        ytmp[nb + i * m_sens + nb] += fbp[i] * gs[0] + fbm[i]
-            elif sens:
-                for i in range(nb, n):
-                    ytmp[i] = xs[i]
-            ev_t[n_ev] = t_ev
-            _put_row(ev_xb, n_ev, xb)
-            _put_row(ev_xa, n_ev, xb2)
-            ev_guard[n_ev] = i_ev
-            ev_from[n_ev] = mode
-            ev_to[n_ev] = new_mode
-            n_ev += 1
-            n_ev_total += 1
-            if record_steps and not use_eval:
-                out_t[n_out] = t_ev
-                _put_row(out_x, n_out, xs)
-                out_mode[n_out] = mode
-                n_out += 1
-            t = t_ev
+            t = t_new
             for i in range(n):
-                x[i] = ytmp[i]
-            if new_mode < 0:
-                status = _S_STOPPED
-                break
-            if new_mode >= n_modes:
-                status = _S_INVALID
-                mode = new_mode
-                break
-            mode = new_mode
+                x[i] = y_new[i]
+                f[i] = f_new[i]
+            for i in range(ng):
+                g_old[i] = g_new[i]
             if record_steps and not use_eval:
                 out_t[n_out] = t
                 _put_row(out_x, n_out, x)
                 out_mode[n_out] = mode
                 n_out += 1
-            # Zeno: zeno_count events within zeno_window, or zeno_count consecutive events of
-            # guards that never armed (the motion chatters inside the guard tolerance)
-            n_threshold = 0 if ev_exact else n_threshold + 1
-            if zeno_count > 0 and n_threshold >= zeno_count:
-                status = _S_ZENO
+            if last:
+                status = _S_SUCCESS
                 break
-            if zeno_count > 0:
-                k = n_ev_total % zeno_count
-                if t - zeno_times[k] < zeno_window:
-                    status = _S_ZENO
-                    break
-                zeno_times[k] = t
-            if stop_mode >= 0 and mode == stop_mode:
-                stop_hits += 1
-                if stop_hits >= stop_count:
-                    status = _S_STOPPED
-                    break
-            if n_ev_total >= max_events:
-                status = _S_MAXEVENTS
-                break
-            nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f)
-            _guards_base(guards, mode, t, x, p, g_old, xb)
-            for i in range(ng):
-                armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
             if fixed:
                 h = h0
+            elif en == 0.0:
+                h *= 1.0 if rejected else MAX_FACTOR
             else:
-                h = min(h, h_mode[mode])
-            continue
-        # ---- no event: accept the whole step
-        while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new:
-            dense_eval(method, t, h, x, Q, t_eval[i_eval], xs)
-            out_t[n_out] = t_eval[i_eval]
-            _put_row(out_x, n_out, xs)
-            out_mode[n_out] = mode
-            n_out += 1
-            i_eval += 1
-        t = t_new
-        for i in range(n):
-            x[i] = y_new[i]
-            f[i] = f_new[i]
-        for i in range(ng):
-            g_old[i] = g_new[i]
-        if record_steps and not use_eval:
-            out_t[n_out] = t
-            _put_row(out_x, n_out, x)
-            out_mode[n_out] = mode
-            n_out += 1
-        if last:
-            status = _S_SUCCESS
-            break
-        if fixed:
-            h = h0
-        elif en == 0.0:
-            h *= 1.0 if rejected else MAX_FACTOR
-        else:
-            h *= min(1.0 if rejected else MAX_FACTOR, SAFETY * en ** expo)
-            h_mode[mode] = h
-        rejected = False
+                h *= min(1.0 if rejected else MAX_FACTOR, SAFETY * en ** expo)
+                h_mode[mode] = h
+            rejected = False
 
-    info[I_STATUS] = status
-    info[I_NOUT] = n_out
-    info[I_NEV] = n_ev
-    info[I_NSTEPS] += n_steps
-    info[I_NREJ] += n_rej
-    info[I_NFEV] += nfev
-    info[I_MODE] = mode
-    info[I_STOPHITS] = stop_hits
-    info[I_IEVAL] = i_eval
-    info[I_NJAC] += njac
-    info[I_NEVTOT] = n_ev_total
-    finfo[F_T] = t
-    finfo[F_H] = h
-    _put(x_final, x)
+        info[I_STATUS] = status
+        info[I_NOUT] = n_out
+        info[I_NEV] = n_ev
+        info[I_NSTEPS] += n_steps
+        info[I_NREJ] += n_rej
+        info[I_NFEV] += nfev
+        info[I_MODE] = mode
+        info[I_STOPHITS] = stop_hits
+        info[I_IEVAL] = i_eval
+        info[I_NJAC] += njac
+        info[I_NEVTOT] = n_ev_total
+        finfo[F_T] = t
+        finfo[F_H] = h
+        _put(x_final, x)
+
+    return integrate_kernel
+
+
+# ---- the compiled kernels: two entries of one body, each compiled on first use
+#
+# Both take KERNEL_SIG, so one compiled kernel of each kind serves every system and parameter
+# value. The lean kernel (DOP853, no sensitivities: simulations and event maps) is a third of
+# the full one's compile time; the full kernel (DP5, Radau IIA, sensitivities and saltation
+# matrices) compiles only when a command needs it. Neither compiles at import.
+
+_OPTIONS = dict(cache=True, error_model="numpy", _nrt=False, nogil=True)
+_DISPATCHERS = {"lean": numba.njit(**_OPTIONS)(_make_kernel(None)), "full": numba.njit(**_OPTIONS)(_make_kernel(True))}
+
+
+def compile_for(disp, sig):
+    """Compile dispatcher ``disp`` for signature ``sig`` unless it has an overload (numba loads
+    it from its disk cache when there) and disable compilation for other types: arguments that
+    do not match are an error instead of a silent per-system specialization. What
+    ``numba.njit(sig)`` does at import, done on first use."""
+    if not disp.overloads:
+        with warnings.catch_warnings():
+            # compiling inside a caller's warning context (pytest's resets the filter that
+            # hunting._fastcall installs at import)
+            warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
+            disp.compile(sig)
+        disp.disable_compile()
+    return disp
+
+
+def compiled(kind: str):
+    """The kernel ``kind`` ("lean" or "full"), compiled for KERNEL_SIG on first use."""
+    return compile_for(_DISPATCHERS[kind], KERNEL_SIG)
+
+
+def kernel_for(method: int, sensitivities: bool = False):
+    """The compiled kernel that runs ``method`` (METHOD_*), with or without sensitivities:
+    the lean kernel for DOP853 without sensitivities, else the full one."""
+    return compiled("lean" if method == METHOD_DOP853 and not sensitivities else "full")
+
+
+def __getattr__(name: str):
+    # integrate_kernel: the full kernel, compiled on first access (PEP 562)
+    if name == "integrate_kernel":
+        return compiled("full")
+    if name == "lean_kernel":
+        return compiled("lean")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -15,12 +15,23 @@ CBRT_EPS = float(np.cbrt(EPS))    # central-difference step factor, not recomput
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out):
+def rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out, full):
     """out = f(y) (plain) or [f(x), J(x) Phi (+ f_mu in the parameter column)] (augmented).
-    Returns extra f evaluations."""
-    if nb == y.size:
+    Returns extra f evaluations.
+
+    ``full`` is None in the lean kernel (no sensitivities: the augmented branch is pruned before
+    typing) and any int in the full kernel. The augmented branch is a call, not inlined: rhs is
+    inlined at every stage of every stepper, and the variational code at each of them doubled
+    the kernels' compile time."""
+    if full is None or nb == y.size:
         vf(mode, t, y, p, out)
         return 0
+    return rhs_augmented(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out)
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
+def rhs_augmented(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out):
+    """The augmented right-hand side [f(x), J(x) Phi (+ f_mu)]; returns extra f evaluations."""
     m = (y.size - nb) // nb
     for i in range(nb):
         yw[i] = y[i]

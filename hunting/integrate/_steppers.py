@@ -31,7 +31,7 @@ def _rms_scaled(err, y, y_new, rtol, atol):
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
 def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, p, direction_span, order, rtol, atol,
-                        ytmp, ftmp):
+                        ytmp, ftmp, full):
     """Hairer's starting step (Solving ODEs I, II.4). Returns h > 0 (one extra f evaluation)."""
     n = y.size
     d0 = 0.0
@@ -49,7 +49,7 @@ def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, 
     h0 = min(h0, direction_span)
     for i in range(n):
         ytmp[i] = y[i] + h0 * f[i]
-    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h0, ytmp, p, ftmp)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h0, ytmp, p, ftmp, full)
     d2 = 0.0
     for i in range(n):
         sc = atol + abs(y[i]) * rtol
@@ -64,12 +64,13 @@ def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
-                  f_new, err):
+                  f_new, err, full):
     """One explicit Runge-Kutta step (DP5 or DOP853, FSAL). Returns the scaled error norm.
 
-    K: (16, n) stage derivatives (rows 0..6 used by DP5, 0..12 by DOP853); writes y_new, f_new."""
+    K: (16, n) stage derivatives (rows 0..6 used by DP5, 0..12 by DOP853); writes y_new, f_new.
+    ``full`` None: DOP853 only (the lean kernel; the DP5 branch is pruned before typing)."""
     n = y.size
-    if method == METHOD_DP5:
+    if full is not None and method == METHOD_DP5:
         ns = 6
         for i in range(n):
             K[0, i] = f[i]
@@ -79,7 +80,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t
                 for j in range(s):
                     acc += DP5_A[s, j] * K[j, i]
                 ytmp[i] = y[i] + h * acc
-            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + DP5_C[s] * h, ytmp, p, err)
+            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + DP5_C[s] * h, ytmp, p, err, full)
             for i in range(n):
                 K[s, i] = err[i]
         for i in range(n):
@@ -87,7 +88,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t
             for j in range(ns):
                 acc += DP5_B[j] * K[j, i]
             y_new[i] = y[i] + h * acc
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new, full)
         for i in range(n):
             K[ns, i] = f_new[i]
         for i in range(n):
@@ -106,7 +107,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t
             for j in range(s):
                 acc += D853_A[s, j] * K[j, i]
             ytmp[i] = y[i] + h * acc
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + D853_C[s] * h, ytmp, p, err)
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + D853_C[s] * h, ytmp, p, err, full)
         for i in range(n):
             K[s, i] = err[i]
     for i in range(n):
@@ -114,7 +115,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t
         for j in range(ns):
             acc += D853_B[j] * K[j, i]
         y_new[i] = y[i] + h * acc
-    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new)
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new, full)
     for i in range(n):
         K[ns, i] = f_new[i]
     e5 = 0.0
@@ -135,10 +136,10 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
-def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, y_new, f_new, h, p, K, ytmp, Q):
+def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, y_new, f_new, h, p, K, ytmp, Q, full):
     """Fill the dense-output coefficients Q for the step just accepted (DOP853: 3 more f evals)."""
     n = y.size
-    if method == METHOD_DP5:
+    if full is not None and method == METHOD_DP5:
         for k in range(4):
             for i in range(n):
                 acc = 0.0
@@ -152,7 +153,7 @@ def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, 
             for j in range(s):
                 acc += D853_A[s, j] * K[j, i]
             ytmp[i] = y[i] + h * acc
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + D853_C[s] * h, ytmp, p, K[s])
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + D853_C[s] * h, ytmp, p, K[s], full)
     for i in range(n):
         dy = y_new[i] - y[i]
         Q[0, i] = dy
@@ -167,11 +168,12 @@ def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, 
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def dense_eval(method, t_old, h, y_old, Q, t, out):
-    """State at time t in [t_old, t_old + h] from the step's dense output."""
+def dense_eval(method, t_old, h, y_old, Q, t, out, full):
+    """State at time t in [t_old, t_old + h] from the step's dense output (``full`` None:
+    DOP853 only)."""
     n = y_old.size
     s = (t - t_old) / h
-    if method == METHOD_DOP853:
+    if full is None or method == METHOD_DOP853:
         for i in range(n):
             acc = 0.0
             for r in range(6, -1, -1):
@@ -220,7 +222,7 @@ def _stage_block_column(Ms, h, b, J, nb):
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False)
 def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
-               R, ytmp, y_new, f_new, err):
+               R, ytmp, y_new, f_new, err, full):
     """One Radau IIA (order 5) step of y = [x (nb), Phi row-major (nb, mc)] (mc = 0: no
     sensitivities, nb = n).
 
@@ -355,7 +357,7 @@ def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, 
             e[i] = fw[i] + acc / h
         lu_solve(Mrs, pivr, e)
         en = _rms_scaled(e, y[:nb], y_new[:nb], rtol, atol)
-    nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new)
+    nfev += 1 + rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new, full)
     return en, True, nfev
 
 

@@ -183,14 +183,15 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     wf, wi = np.empty(nf), np.empty(ni, dtype=np.int64)
     t_cur, x_cur, m_cur = t0, x0, m0
     checked = 0                         # output rows already checked against the limits
+    kernel = K.kernel_for(meth)
     for _ in range(10_000):
         steps_left = int(max_steps) - int(info[K.I_NSTEPS] + info[K.I_NREJ])
-        K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
-                           system.jacobian is not None, meth, n, t_cur, t1, x_cur, m_cur, p, K.NO_PARAM_DIRECTION,
-                           system.directions, rtol, atol, h0, hmax, steps_left, int(max_events),
-                           guard_tol, fixed, te, True, sm, int(stop_count), int(zeno_count), zw,
-                           out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to,
-                           info, finfo, x_final, wf, wi)
+        kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
+               system.jacobian is not None, meth, n, t_cur, t1, x_cur, m_cur, p, K.NO_PARAM_DIRECTION,
+               system.directions, rtol, atol, h0, hmax, steps_left, int(max_events),
+               guard_tol, fixed, te, True, sm, int(stop_count), int(zeno_count), zw,
+               out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to,
+               info, finfo, x_final, wf, wi)
         if info[K.I_STATUS] != Status.BUFFER_FULL:
             break
         if lim is not None:             # stop a diverging run at the first full buffer beyond the limits
