@@ -14,7 +14,7 @@ COG_NONE, COG_HARMONIC, COG_TABLE = 0, 1, 2
 FEXT_NONE, FEXT_CONSTANT, FEXT_TRIANGLE = 0, 1, 2
 
 
-@numba.njit(cache=True, error_model="numpy", inline='always')
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _segment(q, p, d, n):
     """Index lo of the table segment [q_lo, q_lo+1] holding q (bisection; q inside the table)."""
     lo = 0
@@ -28,7 +28,7 @@ def _segment(q, p, d, n):
     return lo
 
 
-@numba.njit(cache=True, error_model="numpy", inline='always')
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def cogging_force(q, p, base):
     """Cogging force F_cog(q) [N] from the flat parameter array, block starting at ``base``:
     [kind, n, L, data...]; harmonic: F = sum_k a_k cos(2 pi k q / L) + b_k sin(2 pi k q / L),
@@ -57,7 +57,7 @@ def cogging_force(q, p, base):
     return (1.0 - w1) * p[d + n + lo] + w1 * p[d + n + lo + 1]
 
 
-@numba.njit(cache=True, error_model="numpy", inline='always')
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def cogging_slope(q, p, base):
     """dF_cog/dq [N/m] of :func:`cogging_force` (table: the slope of the segment; 0 outside)."""
     kind = p[base]
@@ -78,7 +78,7 @@ def cogging_slope(q, p, base):
     return (p[d + n + lo + 1] - p[d + n + lo]) / (p[d + lo + 1] - p[d + lo])
 
 
-@numba.njit(cache=True, error_model="numpy", inline='always')
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def external_force(t, kind, amplitude, period):
     """Known external force [N]: none, constant, or a triangle wave that starts at 0, rises to
     +amplitude at period/4, falls to -amplitude at 3 period/4 and returns to 0 at period."""

@@ -49,7 +49,7 @@ BAND_SLIP, BAND_STICK, BAND_TRANSITION = 0, 1, 2  # switch-banded
 V_POS, V_NEG = 0, 1                               # lugre
 
 
-@numba.njit(cache=True, error_model="numpy", inline='always')
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def nonfriction_force(t, x, p):
     """F_nf = cm u + f_ext(t) - F_cog(q) [N]: every force on the mass except friction."""
     u = -(p[KP] * x[0] + p[KD] * x[1] + p[KI] * x[2])
@@ -57,7 +57,7 @@ def nonfriction_force(t, x, p):
         - cogging_force(x[0] + p[QD], p, COG)
 
 
-@numba.njit(cache=True, error_model="numpy", inline='always')
+@numba.njit(cache=True, error_model="numpy", _nrt=False)
 def _slip(v, s, p):
     base = POS if s > 0 else NEG
     return slip_force(v, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4])
