@@ -81,7 +81,7 @@ def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, xb, gs, ful
     return gs[i]
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, method, p, xs, xb, gs, full):
     """Root of g_i(t) + shift on [ta, tb] given opposite signs at the ends (Illinois method
     with bisection safeguard). Returns the right end of the final bracket: the first time at
@@ -119,7 +119,7 @@ def locate_root(guards, mode, i, shift, ta, ga, tb, gb, t_old, h, y_old, Q, meth
     return tb
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _armed_state(d, g, tol):
     """Is a guard with direction d and value g away from zero on its non-firing side?"""
     if d < 0:
@@ -129,7 +129,7 @@ def _armed_state(d, g, tol):
     return abs(g) > tol
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _fires(d, ga, gb, shift_a_to_b):
     """Does the guard cross zero (after shift) from a to b in its firing direction?"""
     a = ga + shift_a_to_b
@@ -141,7 +141,7 @@ def _fires(d, ga, gb, shift_a_to_b):
     return False
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method, p, xs, xb, gs, full):
     """Scan an unarmed guard over one step. Returns (event time or inf, armed at the end);
     an event found while still unarmed is a threshold event (armed False)."""
@@ -174,7 +174,7 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
     return np.inf, armed
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp, y_new, f_new,
               err, full):
     """One explicit step (see explicit_step): the one copy of the stepper, called by the main
@@ -183,7 +183,7 @@ def _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x,
                          y_new, f_new, err, full)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr,
              Z, F3, R, K, ytmp, y_new, f_new, err, full):
     """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
@@ -196,7 +196,7 @@ def _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, 
     return True, 12 if method == METHOD_DOP853 else 6
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol,
                   J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, xb, gs, full):
     """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
@@ -232,7 +232,7 @@ def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method,
     return t + he, nfev
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def saltation(vf, guards, reset, mode_old, mode_new, i_ev, t, xm, xp, p, S, fm, fp, grad, xw, xw2, gs, Rx):
     """Saltation matrix S (nb, nb) of an event: x+ = R(x-) when guard i_ev of mode_old vanishes,
 
@@ -282,7 +282,7 @@ def saltation(vf, guards, reset, mode_old, mode_new, i_ev, t, xm, xp, p, S, fm, 
     return den
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def saltation_param(guards, reset, mode_old, i_ev, t, xm, p, dpw, gs, xw2, out):
     """Parameter terms of an event for the sensitivity column psi (direction dpw[0]):
     psi+ = S psi + jump * g_mu + R_mu. Writes g_mu to gs[0] and R_mu (nb,) to out; p is

@@ -6,7 +6,7 @@ factorization for several solves, so the factorization is kept here (n <= a few 
 import numba
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def lu_factor(a, piv):
     """Factor ``a`` (m, m) in place into L\\U; ``piv`` (m,) int64 receives row swaps.
 
@@ -38,7 +38,7 @@ def lu_factor(a, piv):
     return True
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def lu_solve(lu, piv, b):
     """Solve in place ``A x = b`` with the factorization from :func:`lu_factor`."""
     m = lu.shape[0]

@@ -29,7 +29,7 @@ def rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out, full)
     return rhs_augmented(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def rhs_augmented(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out):
     """The augmented right-hand side [f(x), J(x) Phi (+ f_mu)]; returns extra f evaluations."""
     m = (y.size - nb) // nb
@@ -52,7 +52,7 @@ def rhs_augmented(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, 
     return extra
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def param_step(p, dpw):
     """Central-difference step in mu for the direction dpw[0] = dp/dmu (relative to the
     parameters it moves)."""
@@ -63,7 +63,7 @@ def param_step(p, dpw):
     return CBRT_EPS * (h if h < np.inf else 1.0)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def param_derivative(vf, mode, t, x, p, dpw, out, fm):
     """out = d f / d mu at x by central differences along dpw[0] (p is perturbed in place and
     restored from dpw[1]; fm is scratch). Returns the f evaluations."""
@@ -82,7 +82,7 @@ def param_derivative(vf, mode, t, x, p, dpw, out, fm):
     return 2
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def jacobian_central_or_exact(vf, jac, has_jac, mode, t, x, p, J, fp, fm, nb):
     """J (nb, nb) at x (x is perturbed in place and restored): analytic or central differences."""
     if has_jac:

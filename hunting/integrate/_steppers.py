@@ -29,7 +29,7 @@ def _rms_scaled(err, y, y_new, rtol, atol):
     return np.sqrt(s / n)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, p, direction_span, order, rtol, atol,
                         ytmp, ftmp, full):
     """Hairer's starting step (Solving ODEs I, II.4). Returns h > 0 (one extra f evaluation)."""
@@ -135,7 +135,7 @@ def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t
     return abs(h) * e5 / np.sqrt(denom * n)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, y_new, f_new, h, p, K, ytmp, Q, full):
     """Fill the dense-output coefficients Q for the step just accepted (DOP853: 3 more f evals)."""
     n = y.size
@@ -193,7 +193,7 @@ def dense_eval(method, t_old, h, y_old, Q, t, out, full):
         out[i] = y_old[i] + acc
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def numerical_jacobian(vf, mode, t, y, f, p, rtol, atol, J, ytmp, ftmp):
     """Forward-difference Jacobian J (n, n) of the mode's vector field at (t, y)."""
     n = y.size
@@ -220,7 +220,7 @@ def _stage_block_column(Ms, h, b, J, nb):
                 Ms[a * nb + i, b * nb + j] = -hab * J[i, j]
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3,
                R, ytmp, y_new, f_new, err, full):
     """One Radau IIA (order 5) step of y = [x (nb), Phi row-major (nb, mc)] (mc = 0: no
@@ -361,7 +361,7 @@ def radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, 
     return en, True, nfev
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def radau_dense(Z, Q):
     """Dense output of the collocation polynomial: Q[k] = (Z^T P)[:, k], k < 3."""
     n = Z.shape[1]

@@ -24,7 +24,7 @@ from ..errors import SystemDefinitionError, check_finite, check_finite_positive
 BETA_DISCONTINUOUS = 0.0
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def pow_ext(r, beta):
     """|r|^beta for r >= 0, extended smoothly a little past r = 0 (used near events): the
     analytic continuation r^beta for integer beta, 0 for r < 0 otherwise."""
@@ -39,7 +39,7 @@ def pow_ext(r, beta):
     return 0.0
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def stribeck_level(vrel, Fc, Fs, vs, beta):
     """Stribeck level g for relative speed ``vrel`` (>= 0 in slip), without viscous part [N].
 
@@ -49,7 +49,7 @@ def stribeck_level(vrel, Fc, Fs, vs, beta):
     return Fc + (Fs - Fc) * math.exp(-pow_ext(vrel / vs, beta))
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def stribeck_level_slope(vrel, Fc, Fs, vs, beta):
     """d g / d vrel of :func:`stribeck_level` (consistent with its extension past 0)."""
     if beta == BETA_DISCONTINUOUS or Fs == Fc:
@@ -75,7 +75,7 @@ def _levels(a, Fc, Fs, vs, beta, slope):
     return out
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def slip_force(v, s, Fc, Fs, vs, beta, b):
     """Friction force in slip with direction s = +1 / -1 (taken from the mode): s g(s v) + b v."""
     return s * stribeck_level(s * v, Fc, Fs, vs, beta) + b * v
@@ -246,7 +246,7 @@ def lugre_rates(v, z, s, Fc, Fs, vs, beta, b, sigma0, sigma1, vd):
     return zdot, sigma0 * z + s1 * zdot + b * v
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def lugre_partials(v, z, s, Fc, Fs, vs, beta, b, sigma0, sigma1, vd):
     """Partial derivatives of (dz/dt, F) of :func:`lugre_rates` with respect to v and z:
     returns (dzdot/dv, dzdot/dz, dF/dv, dF/dz)."""

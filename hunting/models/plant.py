@@ -14,7 +14,7 @@ COG_NONE, COG_HARMONIC, COG_TABLE = 0, 1, 2
 FEXT_NONE, FEXT_CONSTANT, FEXT_TRIANGLE = 0, 1, 2
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _segment(q, p, d, n):
     """Index lo of the table segment [q_lo, q_lo+1] holding q (bisection; q inside the table)."""
     lo = 0
@@ -57,7 +57,7 @@ def cogging_force(q, p, base):
     return (1.0 - w1) * p[d + n + lo] + w1 * p[d + n + lo + 1]
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def cogging_slope(q, p, base):
     """dF_cog/dq [N/m] of :func:`cogging_force` (table: the slope of the segment; 0 outside)."""
     kind = p[base]

@@ -57,7 +57,7 @@ def nonfriction_force(t, x, p):
         - cogging_force(x[0] + p[QD], p, COG)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _slip(v, s, p):
     base = POS if s > 0 else NEG
     return slip_force(v, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4])
@@ -178,7 +178,7 @@ def servo_guards(mode, t, x, p, out):
         out[1] = 1.0
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _switch_mode_at_rest(t, x, p):
     d = direction_from_rest(nonfriction_force(t, x, p), p[POS + 1], p[NEG + 1])
     if d > 0:
