@@ -184,19 +184,6 @@ def _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x,
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv, Mr, pivr,
-             Z, F3, R, K, ytmp, y_new, f_new, err, full):
-    """One step of size he from (t, x) into y_new; returns (success, f evaluations)."""
-    if full is not None and method == METHOD_RADAU:
-        en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, J, M, piv,
-                                  Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err, full)
-        return conv, fe
-    _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, K, ytmp, y_new,
-              f_new, err, full)
-    return True, 12 if method == METHOD_DOP853 else 6
-
-
-@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol,
                   J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, xb, gs, full):
     """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
@@ -214,11 +201,17 @@ def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method,
     he = t_ev - t
     nfev = 0
     for it in range(4):
-        ok, fe = _step_to(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, method, mode, t, x, f, he, p, rtol, atol, J, M, piv,
-                          Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, full)
-        nfev += fe
-        if not ok:
-            return t_ev, nfev
+        # one step of size he from (t, x) into y_new with the method itself
+        if full is not None and method == METHOD_RADAU:
+            en, ok, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, J, M,
+                                    piv, Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err, full)
+            nfev += fe
+            if not ok:
+                return t_ev, nfev
+        else:
+            _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, K, ytmp,
+                      y_new, f_new, err, full)
+            nfev += 12 if method == METHOD_DOP853 else 6
         _guards_base(guards, mode, t + he, y_new, p, gs, xb)
         dh = -gs[i_ev] / slope
         if abs(dh) <= 4.0 * EPS * max(abs(t + he), 1e-300) or it == 3:
