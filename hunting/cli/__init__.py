@@ -35,8 +35,9 @@ import os
 import sys
 import traceback
 
+from .._atomic import OutputPathError
 from ..errors import ConvergenceError, HuntingError
-from .boundary import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, ArgumentParser, Results, check_files
+from .boundary import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, ArgumentParser, Results, check_files, names_stdout
 
 COMMANDS = ("models", "simulate", "eventmap", "continue_", "cycle", "reproduce", "demo", "diagnose")
 EXIT_BROKEN_PIPE = 141          # what a shell reports for a command ended by SIGPIPE
@@ -106,7 +107,7 @@ def main(argv=None) -> int:
         cmd = _commands()[args.cmd]
         outputs, inputs = cmd.files(args) if hasattr(cmd, "files") else ((), ())
         check_files(outputs, inputs)
-        to_stdout = any(o.value == "-" for o in outputs)
+        to_stdout = any(names_stdout(o.value) for o in outputs)
         results = Results(sys.stdout)
         # with results on stdout, everything a command says goes to stderr
         redirect = contextlib.redirect_stdout(sys.stderr) if to_stdout else contextlib.nullcontext()
@@ -133,7 +134,10 @@ def main(argv=None) -> int:
     except OSError as e:                    # a file system failure while writing results
         if debug:
             traceback.print_exc()
-        _say_error(f"{e.strerror or e}" + (f": '{e.filename}'" if e.filename else ""))
+        if isinstance(e, OutputPathError):
+            _say_error(f"'{e.filename}' {e.strerror}")
+        else:
+            _say_error(f"{e.strerror or e}" + (f": '{e.filename}'" if e.filename else ""))
         return EXIT_FAILURE
     except Exception as e:  # noqa: BLE001 -- the last line of defence: one line, never a traceback
         if debug:
