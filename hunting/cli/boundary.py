@@ -11,6 +11,7 @@ import json
 import math
 import errno
 import os
+import re
 import shutil
 import stat
 import tempfile
@@ -30,10 +31,27 @@ class UsageError(HuntingError, ValueError):
     """A command-line argument that is not allowed (exit code 2)."""
 
 
+# What argparse takes for a value, not an option, when it starts with "-": a number in any
+# spelling (-1, -.5, -1e-3, -0.1,0,0 for --x0, -0.5:0.5:11 for --grid, -inf). argparse's own
+# pattern accepts only -1 and -.5 forms, so "--x0 -0.1,0,0" failed with "expected one argument".
+# No option of the command line starts with "-" and a digit, so nothing is lost.
+_NEGATIVE_VALUE = re.compile(r"^-(?:\.?[0-9]|inf|nan)", re.IGNORECASE)
+_NO_VALUE = re.compile(r"^argument ((?:-\w|--[\w-]+)(?:/[\w-]+)*): expected one argument$")
+
+
 class ArgumentParser(argparse.ArgumentParser):
-    """argparse, but a bad argument raises :class:`UsageError` (one line, no usage block)."""
+    """argparse, but a bad argument raises :class:`UsageError` (one line, no usage block), and
+    values may start with a minus sign (``--x0 -0.1,0,0``, ``--grid -0.5:0.5:11``)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_VALUE      # argparse's hook (3.8-3.13)
 
     def error(self, message):
+        m = _NO_VALUE.match(message)
+        if m:                       # e.g. "--json -out.json": a value that looks like an option
+            flag = m.group(1).split("/")[-1]
+            message += f" (to give a value that starts with '-', write {flag}=-...)"
         raise UsageError(f"{message} (see '{self.prog} --help')")
 
 
