@@ -34,9 +34,11 @@ import logging
 import os
 import sys
 import traceback
+import warnings
 
 from .._atomic import OutputPathError
 from ..errors import ConvergenceError, HuntingError
+from .advice import Command, command_of, for_cli
 from .boundary import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, ArgumentParser, Results, check_files, names_stdout
 
 COMMANDS = ("models", "simulate", "eventmap", "continue_", "cycle", "reproduce", "demo", "diagnose")
@@ -56,8 +58,9 @@ def build_parser() -> ArgumentParser:
     ap.add_argument("--version", action="version", version=f"hunting {__version__}")
     ap.add_argument("--debug", action="store_true", help="show the traceback of a failure")
     sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    ap.commands = {}
     for name, mod in _commands().items():
-        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
+        p = ap.commands[name] = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
         p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help="show the traceback of a failure")
         mod.add_arguments(p)
@@ -65,15 +68,20 @@ def build_parser() -> ArgumentParser:
 
 
 class _OneLine(logging.Formatter):
+    def __init__(self, words=None):
+        super().__init__()
+        self._words = words or (lambda text: text)
+
     def format(self, record):
-        return f"hunting: {record.levelname.lower()}: {record.getMessage()}"
+        return f"hunting: {record.levelname.lower()}: {self._words(record.getMessage())}"
 
 
 @contextlib.contextmanager
-def _warnings_to_stderr():
-    """Library warnings (logging) printed as 'hunting: warning: ...' on stderr while a command runs."""
+def _warnings_to_stderr(words=None):
+    """Library warnings (logging) printed as 'hunting: warning: ...' on stderr while a command
+    runs, in the command line's words (``words``: text -> text)."""
     h = logging.StreamHandler(sys.stderr)
-    h.setFormatter(_OneLine())
+    h.setFormatter(_OneLine(words))
     h.setLevel(logging.WARNING)
     logger = logging.getLogger("hunting")
     logger.addHandler(h)
@@ -83,8 +91,21 @@ def _warnings_to_stderr():
         logger.removeHandler(h)
 
 
-def _say_error(message: str) -> None:
-    one_line = " ".join(str(message).split())
+@contextlib.contextmanager
+def _python_warnings_one_line():
+    """Python warnings (numpy's RuntimeWarning from inside a computation) as one line each on
+    stderr, not the two-line source listing."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        where = os.path.splitext(os.path.basename(filename))[0]
+        print(f"hunting: warning: {message} ({category.__name__} in {where})", file=sys.stderr)
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        yield
+
+
+def _say_error(message: str, command: Command | None = None) -> None:
+    message = for_cli(str(message), command) if command is not None else str(message)
+    one_line = " ".join(message.split())
     print(f"hunting: error: {one_line}", file=sys.stderr)
 
 
@@ -99,11 +120,14 @@ def main(argv=None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in argv
+    command = None                          # the command, once known: its messages in its words
     try:
+        parser = build_parser()
         try:
-            args = build_parser().parse_args(argv)
+            args = parser.parse_args(argv)
         except SystemExit as e:             # --help and --version
             return int(e.code or 0)
+        command = args.cli_command = command_of(args, parser)
         cmd = _commands()[args.cmd]
         outputs, inputs = cmd.files(args) if hasattr(cmd, "files") else ((), ())
         check_files(outputs, inputs)
@@ -111,7 +135,7 @@ def main(argv=None) -> int:
         results = Results(sys.stdout)
         # with results on stdout, everything a command says goes to stderr
         redirect = contextlib.redirect_stdout(sys.stderr) if to_stdout else contextlib.nullcontext()
-        with _warnings_to_stderr(), redirect:
+        with _warnings_to_stderr(lambda text: for_cli(text, command)), _python_warnings_one_line(), redirect:
             code = cmd.run(args, results)
         sys.stdout.flush()
         return code
@@ -124,20 +148,20 @@ def main(argv=None) -> int:
     except ConvergenceError as e:
         if debug:
             traceback.print_exc()
-        _say_error(str(e))
+        _say_error(str(e), command)
         return EXIT_FAILURE
     except (HuntingError, ValueError) as e:
         if debug:
             traceback.print_exc()
-        _say_error(str(e))
+        _say_error(str(e), command)
         return EXIT_USAGE
     except OSError as e:                    # a file system failure while writing results
         if debug:
             traceback.print_exc()
         if isinstance(e, OutputPathError):
-            _say_error(f"'{e.filename}' {e.strerror}")
+            _say_error(f"'{e.filename}' {e.strerror}", command)
         else:
-            _say_error(f"{e.strerror or e}" + (f": '{e.filename}'" if e.filename else ""))
+            _say_error(f"{e.strerror or e}" + (f": '{e.filename}'" if e.filename else ""), command)
         return EXIT_FAILURE
     except Exception as e:  # noqa: BLE001 -- the last line of defence: one line, never a traceback
         if debug:

@@ -93,6 +93,17 @@ def positive_int(text: str) -> int:
     return v
 
 
+def nonnegative_int(text: str) -> int:
+    """An integer >= 0."""
+    try:
+        v = int(text.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer (allowed: an integer >= 0)") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: an integer >= 0 is required")
+    return v
+
+
 def name_value(text: str) -> tuple[str, str]:
     """NAME=VALUE (for --set); the value is checked by whatever owns the name."""
     name, sep, value = text.partition("=")
