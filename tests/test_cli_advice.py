@@ -162,3 +162,11 @@ def test_continue_range_options_are_checked(capsys, argv, message):
     code = main(["continue", "table9.1", "--param", "P", *argv.split()])
     err = capsys.readouterr().err
     assert code == 2 and message in err and err.count("\n") == 1
+
+
+def test_eventmap_defined_nowhere_is_a_failure(capsys):
+    """--iterate 1000: only d = 0 reaches its stick phases (was: exit 0 with a warning)."""
+    code = main(["eventmap", "table9.1", "--grid", "0:0.5:11", "--iterate", "1000"])
+    err = capsys.readouterr().err
+    assert code == 1 and "no map: P^1000 is defined at 1 of 11 grid points (MAX_EVENTS at 10)" in err
+    assert "lower --iterate" in err

@@ -1,13 +1,15 @@
 """The ``hunting`` command.
 
     hunting models                      presets and their parameters with units
-    hunting simulate PRESET [--set NAME=VALUE ...] [--x0 X1,X2,X3] [--t T] [--json F] [--plot F]
+    hunting simulate PRESET [--set NAME=VALUE ...] [--x0 X1,X2,X3] [--t T] [--method M] [--rtol R]
+                     [--atol A] [--max-steps N] [--max-events N] [--max-samples N] [--json F] [--plot F]
     hunting eventmap PRESET [--set NAME=VALUE ...] --grid START:STOP:N [--iterate K]
                      [--json FILE] [--plot FILE]
     hunting continue PRESET [--set NAME=VALUE ...] --param NAME --from A --to B [--back-to C]
-                     [--json FILE] [--plot FILE]
+                     [--max-points N] [--ds-max S] [--ds-min S] [--json FILE] [--plot FILE]
+                                        exit 1 when the branch stops short of B
     hunting cycle PRESET [--set NAME=VALUE ...] [--x0 NAME=V,...] [--period-guess T]
-                     [--which stable|unstable] [--json FILE] [--plot FILE]
+                     [--which stable|unstable] [--t-max T] [--d-max D] [--json FILE] [--plot FILE]
                                         a periodic orbit: period, multipliers, stick phases
     (simulate, eventmap, continue and cycle take --model FILE, a model description, instead
     of PRESET)
@@ -17,9 +19,10 @@
                      [--names KEY=COLUMN,...] [--drop COLUMN]   measured data against the model
 
 Every command checks its arguments and output paths before computing, writes result files
-whole (a temporary file, then a rename; ``--json -`` writes to standard output) and reports a
-failure in one line: exit code 2 for bad input, 1 for a numerical failure. ``--debug`` shows
-the traceback.
+whole (a temporary file, then a rename; devices, FIFOs and ``/dev/stdout`` directly, see
+:mod:`hunting._atomic`; ``--json -`` writes to standard output) and reports a failure in one
+line, in the command line's words (:mod:`hunting.cli.advice`): exit code 2 for bad input, 1 for
+a numerical failure. ``--debug`` shows the traceback.
 
 A command is a module in this package with ``NAME``, ``HELP``, ``add_arguments(parser)``,
 ``run(args, results) -> exit code`` and optionally ``files(args) -> (outputs, inputs)``; it is
