@@ -212,3 +212,22 @@ def test_dev_stdout_is_the_results_stream(capfd):
     code = main(["simulate", "table9.1", "--x0", "0.1", "--t", "0.5", "--json", "/dev/stdout"])
     out, err = capfd.readouterr()
     assert code == 0 and out.lstrip().startswith("{") and "SUCCESS" in err
+
+
+def test_dev_null_twice_with_stdout_on_dev_null(tmp_path):
+    """`hunting ... --json /dev/null --plot /dev/null > /dev/null` (a CI job's stdout): both
+    outputs discarded, exit 0 (a character device is never taken for standard output)."""
+    import subprocess
+    import sys
+    node = _char_device_in(tmp_path)
+    ino = os.lstat(node).st_ino
+    write_text(node, "x")
+    assert stat.S_ISCHR(os.lstat(node).st_mode) and os.lstat(node).st_ino == ino     # guard first
+    before = os.lstat("/dev/null")
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    r = subprocess.run([sys.executable, "-m", "hunting.cli", "simulate", "table9.1", "--x0", "0.1", "--t", "0.5",
+                        "--json", "/dev/null", "--plot", "/dev/null"], stdout=subprocess.DEVNULL,
+                       stderr=subprocess.PIPE, text=True, env=env, timeout=300)
+    after = os.lstat("/dev/null")
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    assert stat.S_ISCHR(after.st_mode) and after.st_ino == before.st_ino

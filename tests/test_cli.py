@@ -367,3 +367,19 @@ def test_a_negative_value_where_none_is_allowed_names_the_option(capsys, argv, e
 def test_simulate_from_a_negative_start(capsys):
     code, out, _ = run_main(capsys, ["simulate", "table9.1", "--x0", "-0.1,0,0", "--t", "3"])
     assert code == 0 and out.startswith("SUCCESS")
+
+
+def test_pgf_without_tex_is_refused_before_computing(monkeypatch, capsys, tmp_path):
+    """`--plot f.pgf` needs the TeX program of matplotlib's pgf backend (was: a RuntimeError after
+    the computation, the figure lost)."""
+    import shutil
+
+    import hunting.integrate
+
+    def computed(*a, **k):
+        raise AssertionError("computed before checking the outputs")
+    monkeypatch.setattr(hunting.integrate, "simulate", computed)
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    code, _, err = run_main(capsys, ["simulate", "table9.1", "--plot", str(tmp_path / "f.pgf")])
+    line = one_line_error(err)
+    assert code == 2 and "writing .pgf needs the TeX program 'xelatex'" in line and ".png" in line

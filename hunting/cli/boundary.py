@@ -359,13 +359,16 @@ def result_files(args):
 
 def names_stdout(value) -> bool:
     """Whether an output value means this process' standard output: "-", or a path that is the
-    same open file (``/dev/stdout``, ``/dev/fd/1``, a file stdout is redirected to)."""
+    same pipe or file (``/dev/stdout``, ``/dev/fd/1``, a file stdout is redirected to). A
+    character device is not: ``--json /dev/null`` stays a device written directly, even when
+    stdout is /dev/null too (a terminal takes both alike)."""
     if value == "-":
         return True
     if value is None:
         return False
     try:
-        return os.path.samestat(os.stat(value), os.fstat(1))
+        st = os.stat(value)
+        return not stat.S_ISCHR(st.st_mode) and os.path.samestat(st, os.fstat(1))
     except (OSError, ValueError):
         return False
 
