@@ -170,3 +170,11 @@ def test_eventmap_defined_nowhere_is_a_failure(capsys):
     err = capsys.readouterr().err
     assert code == 1 and "no map: P^1000 is defined at 1 of 11 grid points (MAX_EVENTS at 10)" in err
     assert "lower --iterate" in err
+
+
+@pytest.mark.parametrize("grid", ["abc", [0.1], [0.0, float("nan")], [[0.1, "x"]]])
+def test_fixed_points_name_a_bad_grid(grid):
+    """(was: a bare numpy ValueError for "abc", an empty list for one point)"""
+    from hunting.eventmap import fixed_points
+    with pytest.raises(hunting.SystemDefinitionError, match="grid = .* is not allowed: at least 2 finite"):
+        fixed_points("table9.1", grid, 2)

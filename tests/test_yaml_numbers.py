@@ -36,3 +36,9 @@ def test_yaml_keeps_strings_and_expressions(tmp_path):
     f = tmp_path / "m.yaml"
     f.write_text("a: '1e5'\nb: e5\nc: 1e\nd: Fs - 10*q\ne: 100\n")
     assert read_description(f) == {"a": "1e5", "b": "e5", "c": "1e", "d": "Fs - 10*q", "e": 100}
+
+
+def test_a_directory_is_named_as_one(tmp_path):
+    from hunting.errors import SystemDefinitionError
+    with pytest.raises(SystemDefinitionError, match="is a directory"):
+        read_description(tmp_path)

@@ -15,6 +15,8 @@ from .description import validate
 def read_description(path) -> dict:
     """The description dict in a JSON or YAML file (by suffix; other suffixes: JSON, then YAML)."""
     p = Path(path)
+    if p.is_dir():
+        raise SystemDefinitionError(f"model file {str(p)!r} is a directory (allowed: a JSON or YAML file)")
     if not p.is_file():
         raise SystemDefinitionError(f"model file {str(p)!r} does not exist")
     text = p.read_text()
