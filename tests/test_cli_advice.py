@@ -12,11 +12,10 @@ import pytest
 
 import hunting
 from hunting.cli import build_parser, main
-from hunting.cli.advice import Command, for_cli
+from hunting.cli.advice import Command, for_cli, library_advice
 from hunting.cli.continue_ import outcome
-from hunting.continuation.status import _ADVICE as ORBIT_ADVICE
 from hunting.continuation.status import OrbitStatus
-from hunting.errors import _ADVICE as STATUS_ADVICE
+from hunting.errors import status_message
 from hunting.results import SpecialPoint
 
 PARSER = build_parser()
@@ -24,8 +23,7 @@ COMMANDS = sorted(PARSER.commands)
 API_WORDS = re.compile(r"period_guess|t_max|d_max|max_steps|max_events|max_points|ds_min|ds_max|t_span|"
                        r"method='radau'|simulate's growth|transition function|find_cycle|\(x0\)|\(x0,|\btol\b")
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
-LIBRARY_ADVICE = sorted({*ORBIT_ADVICE.values(), *STATUS_ADVICE.values(),
-                         "the stick states are not a one-parameter family. Use find_cycle instead"})
+LIBRARY_ADVICE = sorted({*library_advice(), "the stick states are not a one-parameter family. Use find_cycle instead"})
 
 
 def _command(name, model_file=False):
@@ -53,14 +51,14 @@ def test_the_reviewers_messages_in_cli_words():
     assert "--max-points 400 reached" in for_cli(
         "max_points = 400 reached at vb = 8.49385: raise max_points or ds_max", cont)
     assert "raise --max-points or --ds-max" in for_cli("raise max_points or ds_max", cont)
-    assert for_cli(STATUS_ADVICE[hunting.Status.STEP_TOO_SMALL], sim).count("--method radau") == 1
-    zeno = for_cli(STATUS_ADVICE[hunting.Status.ZENO], sim)
+    assert for_cli(status_message(hunting.Status.STEP_TOO_SMALL), sim).count("--method radau") == 1
+    zeno = for_cli(status_message(hunting.Status.ZENO), sim)
     assert "model file's friction entries" in zeno and "transition function" not in zeno
     assert "'hunting cycle' instead" in for_cli("not a one-parameter family. Use find_cycle instead", cycle)
 
 
 def test_an_advice_sentence_is_said_once():
-    advice = ORBIT_ADVICE[OrbitStatus.SINGULAR_JACOBIAN]
+    advice = OrbitStatus.SINGULAR_JACOBIAN.advice
     text = (f"returns to q2 = 0.0342 did not repeat; shooting from the returns gave SINGULAR_JACOBIAN: singular "
             f"shooting Jacobian at iteration 1: {advice}. {advice[0].upper()}{advice[1:]}")
     said = for_cli(text, _command("cycle"))

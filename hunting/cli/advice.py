@@ -64,7 +64,9 @@ def _equilibrium(cmd, m):
 
 def _not_converged(cmd, m):
     guess = _either(cmd, [("--x0", "--x0"), ("--period-guess", "--period-guess")], "")
-    return f"improve the guess ({guess})" if guess else "start from other parameter values" + _flags(cmd, "--from", "--set")
+    if guess:
+        return f"improve the guess ({guess})"
+    return "start from other parameter values" + _flags(cmd, "--from", "--set")
 
 
 def _d_max(cmd, m):
@@ -169,10 +171,14 @@ def _named(cmd: Command, m) -> str:
 
 def _advice_sentences() -> list[str]:
     """The library's advice texts (long enough that a repetition is a repetition), longest first."""
-    from ..continuation.status import _ADVICE as orbit_advice
-    from ..errors import _ADVICE as status_advice
-    return sorted({a for a in (*orbit_advice.values(), *status_advice.values()) if len(a) > 40}, key=len,
-                  reverse=True)
+    return sorted({a for a in library_advice() if len(a) > 40}, key=len, reverse=True)
+
+
+def library_advice() -> list[str]:
+    """Every advice text of the integrator's and the orbit methods' status codes."""
+    from ..continuation.status import OrbitStatus
+    from ..errors import Status, status_message
+    return [*(status_message(s) for s in Status), *(s.advice for s in OrbitStatus)]
 
 
 def _once(text: str) -> str:

@@ -82,26 +82,24 @@ def positive_float(text: str) -> float:
     return v
 
 
-def positive_int(text: str) -> int:
-    """An integer >= 1."""
+def _int_at_least(text: str, low: int) -> int:
     try:
         v = int(text.strip())
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer (allowed: an integer >= 1)") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: an integer >= 1 is required")
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer (allowed: an integer >= {low})") from None
+    if v < low:
+        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: an integer >= {low} is required")
     return v
+
+
+def positive_int(text: str) -> int:
+    """An integer >= 1."""
+    return _int_at_least(text, 1)
 
 
 def nonnegative_int(text: str) -> int:
     """An integer >= 0."""
-    try:
-        v = int(text.strip())
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer (allowed: an integer >= 0)") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: an integer >= 0 is required")
-    return v
+    return _int_at_least(text, 0)
 
 
 def name_value(text: str) -> tuple[str, str]:
