@@ -266,9 +266,13 @@ def stick_family(obj, *, d_state: str | None = None, seed: int = 0) -> StickFami
                                         f"{[names[i] for i in frozen]}")
         frozen = [names.index(d_state)]
     if len(frozen) != 1 or len(moving) != 1:
-        what = ("every stick phase ends at the same state (nothing stays frozen to tell them apart)" if not frozen
-                else f"in stick {[names[i] for i in moving] or 'no state'} evolve and {[names[i] for i in frozen]} "
-                     f"stay frozen")
+        evolve, stay = [names[i] for i in moving], [names[i] for i in frozen]
+        if not frozen and len(moving) <= 1:
+            what = (f"every stick phase ends at the same state (only {evolve or 'no state'} drifts and nothing "
+                    "stays frozen to tell the phases apart)")
+        else:
+            what = (f"in stick {len(evolve)} state(s) evolve ({', '.join(evolve) or 'none'}) and {len(stay)} stay "
+                    f"frozen ({', '.join(stay) or 'none'})")
         raise SystemDefinitionError(f"{name}: the stick states are not a one-parameter family: {what}; a 1-D "
                                     f"stick-exit map needs exactly one frozen state (the stick error) and one that "
                                     f"drifts (e.g. a PID servo's position error and integral). Use find_cycle instead")
