@@ -94,7 +94,9 @@ def belt_reference_cycle(m=1.0, k=2.0, Fc=0.3, Fs=0.5, vs=0.05, vb=0.1):
         return [y[1], (-k * y[0] - F) / m]
 
     def w_zero(t, y):
-        return y[1] - vb
+        # armed after the first microsecond: the start is on w = 0 itself (solve_ivp would
+        # otherwise report the start as the event for some vb)
+        return y[1] - vb if t > 1e-6 else -1.0
     w_zero.terminal, w_zero.direction = True, 1.0
     q_b = Fs / k
     # leave the break-away state (w = 0) before the event is armed
