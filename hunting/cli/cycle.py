@@ -55,5 +55,5 @@ def run(args, results) -> int:
     if args.plot:
         sys_ = choice.system if res.orbit is None or res.orbit.params is None else \
             choice.system.with_param_array(res.orbit.params)
-        plot_cycle(res, sys_, units=dict(getattr(choice.system, "units", {}) or {}), path=args.plot)
+        plot_cycle(res, sys_, model=choice.model, path=args.plot)
     return 0

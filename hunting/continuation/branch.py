@@ -17,7 +17,7 @@ bracketed between two branch points with the event counts before and after.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -99,7 +99,8 @@ class Branch:
     multipliers : (m, n) complex (trivial first); stable : (m,) bool; x0 : (m, n);
     modes : list of mode sequences; special : list of SpecialPoint; status : OrbitStatus
     (SUCCESS: the run ended where asked; POINT_LIMIT, STEP_LIMIT, NO_START, INTEGRATION_FAILED);
-    message : what happened and what to change; label; state_names : names of the x0 columns."""
+    message : what happened and what to change; label; state_names : names of the x0 columns;
+    units : the system's units by name (figure labels; empty when unknown)."""
 
     param: str
     mu: np.ndarray
@@ -114,6 +115,7 @@ class Branch:
     message: str
     label: str = ""
     state_names: tuple = ()
+    units: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         names = self.state_names or tuple(f"x{i + 1}" for i in range(self.x0.shape[1] if self.x0.ndim == 2 else 0))
@@ -536,7 +538,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     special = _merge_grazing(special)
     g = special[-1] if special else None
     if (status == OrbitStatus.STEP_LIMIT and g is not None and g.kind == "grazing"
-            and g.interval[0] - 10 * g.precision <= mus[-1] <= g.interval[1] + 10 * g.precision):
+            and abs(mus[-1] - g.param) <= max(100 * g.precision, 1e-3 * abs(mu_end - mu0))):
         message = (f"the corrector failed at step ds < ds_min = {opt.ds_min:g} at a grazing point near {param} = "
                    f"{g.param:.6g}, where the event sequence changes ({' -> '.join(g.data['modes_before'])} to "
                    f"{' -> '.join(g.data['modes_after'])}): the branch is not smooth there. Restart the "
@@ -544,8 +546,9 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     if capped_at:
         message += (f" (from {param} = {capped_at[0]:.6g} on, flows with steps of at most T / {STEPS_PER_PERIOD}: "
                     f"one had stepped over a short event)")
+    sys0 = system_at(mu0)
     return Branch(param, np.array(mus), np.array(Ts), np.array(amps), lams, np.array(stab), np.array(xs), modes,
-                  special, status, message, state_names=tuple(system_at(mu0).state_names))
+                  special, status, message, state_names=tuple(sys0.state_names), units=dict(sys0.units or {}))
 
 
 def _merge_grazing(special: list) -> list:

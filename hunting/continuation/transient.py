@@ -222,13 +222,15 @@ def _choose_state(x: np.ndarray, ok: np.ndarray, floor: float):
     return None if best is None else best[1:]
 
 
-def _refine_return(system: PiecewiseSystem, xk, mode, h, s, c, amp, opt: StartOptions):
-    """Time tau in (0, h] and state where x[s] crosses c upward on the smooth piece starting at
-    xk in ``mode`` (no event inside): Newton on tau with bisection safeguards, on short flows."""
+def _refine_return(system: PiecewiseSystem, xk, mode, h, s, c, amp, opt: StartOptions, direction: int = 1):
+    """Time tau in (0, h] and state where x[s] crosses c upward (``direction`` 1; -1:
+    downward) on the smooth piece starting at xk in ``mode`` (no event inside): Newton on tau
+    with bisection safeguards, on short flows."""
     a, b = 0.0, float(h)
-    fa = xk[s] - c
+    sg = 1.0 if direction >= 0 else -1.0
+    fa = sg * (xk[s] - c)
     fl_b = flow(system, xk, b, mode0=mode, sensitivity=False, rtol=opt.rtol, atol=opt.atol)
-    fb = fl_b.x[s] - c
+    fb = sg * (fl_b.x[s] - c)
     if not fl_b.ok or fa >= 0 or fb < 0:
         return None
     tau = b * (-fa) / (fb - fa)
@@ -238,14 +240,14 @@ def _refine_return(system: PiecewiseSystem, xk, mode, h, s, c, amp, opt: StartOp
         if fl is None or not fl.ok:
             return None
         x = fl.x
-        g = x[s] - c
+        g = sg * (x[s] - c)
         if abs(g) <= 1e-12 * amp:
             break
         if g < 0:
             a = tau
         else:
             b = tau
-        fs = fl.f[s]
+        fs = sg * fl.f[s]
         step = tau - g / fs if np.isfinite(fs) and fs > 0 else 0.5 * (a + b)
         new = step if a < step < b else 0.5 * (a + b)
         if abs(new - tau) <= 1e-15 * h:
@@ -348,10 +350,10 @@ def _shooting_start(system: PiecewiseSystem, x_ret, T, scale, opt: StartOptions,
     the mode at x_ret when it lies on a switching surface).
 
     The section is x[s] = c with c the middle of the range of a state s that moves well above
-    the noise floor: among the states oscillating most (range relative to size at least half
-    the largest), the one crossing its middle upwards least often (a position crosses once a
-    period, so the section stays transversal while a continuation changes the orbit), ties to
-    the faster crossing; x is that crossing, located exactly. Crossings in a stick mode (its
+    the noise floor: among those states, the one crossing its middle least often (a position crosses twice a period,
+    so the section stays transversal while a continuation changes the orbit), ties to the first
+    in state order (positions usually come first: the continuation takes fewer, longer steps on
+    them); x is one of its crossings, located exactly. Crossings in a stick mode (its
     surface state is fixed: Newton would move it off, and the mode at the start would become
     ambiguous) or within T / 200 of an event are not taken. Without such a crossing: the
     sample where the orbit moves fastest relative to ``scale``. None when the simulation
@@ -372,20 +374,19 @@ def _shooting_start(system: PiecewiseSystem, x_ret, T, scale, opt: StartOptions,
     moving = rng > floor
     best = None
     if np.any(moving):
-        rel = np.where(moving, rng / (np.max(np.abs(x), axis=0) + 1e-300), 0.0)
-        for i in np.flatnonzero(moving & (rel >= 0.5 * rel.max())):
+        for i in np.flatnonzero(moving):
             c = 0.5 * (lo[i] + hi[i])
-            ks = np.flatnonzero(ok & (x[:-1, i] < c) & (x[1:, i] >= c))
+            up = (x[:-1, i] < c) & (x[1:, i] >= c)
+            down = (x[:-1, i] > c) & (x[1:, i] <= c)
+            count = int(np.count_nonzero(up | down))          # how often it crosses, anywhere
+            ks = np.flatnonzero(ok & (up | down))             # where a start may lie
             if ks.size == 0:
                 continue
-            k = int(ks[0])
-            speed = abs(float(system.evaluate(x[k], int(md[k]))[i])) / rng[i]
-            key = (ks.size, -speed)
-            if best is None or key < best[0]:
-                best = (key, i, k, c)
+            if best is None or count < best[0]:
+                best = (count, i, int(ks[0]), c, 1 if up[ks[0]] else -1)
     if best is not None:
-        _, i, k, c = best
-        r = _refine_return(system, x[k], int(md[k]), t[k + 1] - t[k], i, c, rng[i], opt)
+        _, i, k, c, direction = best
+        r = _refine_return(system, x[k], int(md[k]), t[k + 1] - t[k], i, c, rng[i], opt, direction)
         if r is not None:
             return r[1], int(i)
     # no clean crossing: the free sample where the orbit moves fastest
