@@ -26,7 +26,8 @@ def add_arguments(p) -> None:
                    help="a period guess [s]: shoot from --x0 first (reaches unstable cycles), "
                         "and scale the transient by it")
     p.add_argument("--which", choices=("stable", "unstable"), default="stable",
-                   help="for a preset without --x0: the stable (default) or unstable cycle of its event map")
+                   help="without --x0: the stable (default) or unstable cycle of the event map (presets, and "
+                        "models with one Switch contact whose stick phases form a one-parameter family)")
     add_result_arguments(p, "the orbit", "the orbit with its stick phases shaded")
 
 
@@ -39,9 +40,10 @@ def run(args, results) -> int:
     choice = resolve_system(args)
     names = list(choice.system.state_names)
     x0 = args.x0.vector(names) if args.x0 else None
-    if args.which == "unstable" and (x0 is not None or choice.preset is None) and args.period_guess is None:
-        raise UsageError("--which unstable needs a preset without --x0 (its event map), or --x0 with "
-                         "--period-guess (shooting from there): a simulation never settles on an unstable cycle")
+    if args.which == "unstable" and x0 is not None and args.period_guess is None:
+        raise UsageError("--which unstable needs no --x0 (the event map of a preset or of a model with one "
+                         "Switch contact), or --x0 with --period-guess (shooting from there): a simulation never "
+                         "settles on an unstable cycle")
     res = find_cycle(choice.source, x0, args.period_guess, choice.params, which=args.which)
     if res.success:
         print(res.summary())

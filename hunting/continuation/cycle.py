@@ -2,17 +2,19 @@
 
 Three ways in, tried in this order:
 
-1. for a servo loop (a preset or ServoLoop) without a user start, the stick-to-stick event map
-   of its exact-Switch twin over the whole stick-error range the map reaches
-   (:func:`stick_error_range`) gives the stick error of the cycle and a shooting guess;
+1. without a user start, the stick-to-stick event map (:func:`stick_map`): a servo loop's
+   exact-Switch twin, or the stick family of a model with one Switch contact, over the whole
+   stick-error range the map reaches (:func:`stick_error_range`), gives the stick error of the
+   cycle and a shooting guess (or says that the equilibrium set attracts and there is none);
 2. with a period guess, shooting straight from the user's state (this reaches unstable cycles
    a simulation never settles on);
-3. a transient simulation from the user's state until the return map on a section settles
-   (:mod:`hunting.continuation.transient`), shooting from the settled return.
+3. a transient simulation from the user's state until the return map settles
+   (:mod:`hunting.continuation.transient`), shooting from inside the settled orbit.
 
-When none succeeds, the result says why with an :class:`OrbitStatus`: the motion came to rest
-(EQUILIBRIUM), grew without bound (ESCAPE), did not recur (NO_RECURRENCE), or shooting failed
-(SINGULAR_JACOBIAN, NOT_CONVERGED, INTEGRATION_FAILED).
+Every orbit found is reduced to its minimal period and checked for events its flow stepped
+over. When none succeeds, the result says why with an :class:`OrbitStatus`: the motion came to
+rest (EQUILIBRIUM), grew without bound (ESCAPE), did not recur (NO_RECURRENCE), or shooting
+failed (SINGULAR_JACOBIAN, NOT_CONVERGED, INTEGRATION_FAILED).
 """
 from __future__ import annotations
 
@@ -202,7 +204,8 @@ def _presliding_segments(c, tr, T) -> list:
 
 
 def phases_of(target: Target, period: float, event_times, modes, tr=None) -> tuple:
-    """Stick and slip phases of each contact along one period (see Phase), from the mode
+    """Stick and slip phases of every contact in order along one period (by start time; see
+    Phase), from the mode
     sequence ``modes`` (k + 1,) between the event times (k,) in [0, period]; for a contact
     without stick modes (LuGre) whose relative velocity is known, from |w| on the sampled
     period ``tr`` (below PRESLIDING_FRACTION of its largest value: stick)."""
@@ -220,7 +223,8 @@ def phases_of(target: Target, period: float, event_times, modes, tr=None) -> tup
                                sys_.modes[m].name if 0 <= m < sys_.n_modes else str(m)) for a, b, m in segs], T)
         for kind, a, b, names in pieces:
             out.append(Phase(kind, float(b - a), float(a % T) if T > 0 else 0.0, c.name, tuple(names)))
-    return tuple(out)
+    order = {c.name: k for k, c in enumerate(target.contacts)}
+    return tuple(sorted(out, key=lambda p: (p.start, order.get(p.contact, 0))))      # along the period
 
 
 def one_period(system: PiecewiseSystem, x0, T: float, mode0: int | None = None, n: int = 4001,
@@ -698,9 +702,10 @@ def find_cycle(system, x0=None, period_guess: float | None = None, params: dict 
         if which == "unstable":
             # a transient never settles on an unstable cycle: shoot from the map's guess or stop
             if hint is None:
-                why = ms.how if smap is not None else (f"{ms.how}: give x0 and period_guess (--x0, --period-guess) "
-                                                       f"near the unstable cycle to shoot from there")
-                return _failure(target, OrbitStatus.NO_CYCLE, _with_advice(why, OrbitStatus.NO_CYCLE), throw)
+                why = (_with_advice(ms.how, OrbitStatus.NO_CYCLE) if smap is not None else
+                       f"{ms.how}: give x0 and period_guess (--x0, --period-guess) near the unstable cycle to shoot "
+                       f"from there (a simulation never settles on it)")
+                return _failure(target, OrbitStatus.NO_CYCLE, why, throw)
             po = shoot(sys_, hint, ms.period, section=_section_at(sys_, hint, ms.period), options=shooting)
             if po.success and not po.stable:
                 return _result(target, po, f"{ms.how}, then shooting", shooting)

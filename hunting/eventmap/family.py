@@ -299,12 +299,20 @@ def stick_family(obj, *, d_state: str | None = None, seed: int = 0) -> StickFami
                                         f"{[names[i] for i in frozen]}")
         frozen = [names.index(d_state)]
     if len(frozen) != 1 or len(moving) != 1:
-        what = ("every stick phase ends at the same state (nothing stays frozen to tell them apart)" if not frozen
-                else f"in stick {[names[i] for i in moving] or 'no state'} evolve and {[names[i] for i in frozen]} "
-                     f"stay frozen")
+        ev = ", ".join(names[i] for i in moving) or "no state"
+        fr = ", ".join(names[i] for i in frozen) or "none"
+        if not frozen and len(moving) == 1:
+            what = (f"in stick only {ev} evolves and nothing stays frozen, so every stick phase ends at the same "
+                    f"state (one break-away state: the map has a single point)")
+        elif not frozen:
+            what = (f"in stick {ev} evolve and none stays frozen (more than one free state: a stick phase is "
+                    f"not fixed by one number)")
+        else:
+            what = f"in stick {ev} evolve{'s' if len(moving) == 1 else ''} and {fr} stay{'s' if len(frozen) == 1 else ''} frozen"
         raise SystemDefinitionError(f"{name}: the stick states are not a one-parameter family: {what}; a 1-D "
                                     f"stick-exit map needs exactly one frozen state (the stick error) and one that "
-                                    f"drifts (e.g. a PID servo's position error and integral). Use find_cycle instead")
+                                    f"drifts (e.g. a PID servo's position error and integral). Find its cycles with "
+                                    f"`hunting cycle` (find_cycle) instead")
     di, ei = frozen[0], moving[0]
     # d0: the frozen value at which the drift stops (the drift is probed at two values of d)
     x = probes[0].copy()
