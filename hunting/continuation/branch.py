@@ -421,6 +421,9 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             # needs to recompute it
             J_pred = J + (J - J_prev) * (ds / float(np.linalg.norm(v - pts_v[-2])))
         res = correct(v_pred, t, J_pred)
+        if res is not None and missed(res[0]):
+            # the point is not an orbit of the system: correct it again with bounded steps
+            res = correct(res[0], t, res[1], reuse=False)
         if res is None:
             ds *= 0.5
             if ds < opt.ds_min:
@@ -430,18 +433,6 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
                 break
             continue
         v_new, J_new, fl_new, refreshes = res
-        if missed(v_new):
-            # the point is not an orbit of the system: correct it again with bounded steps
-            res = correct(v_new, t, J_new, reuse=False)
-            if res is None:
-                ds *= 0.5
-                if ds < opt.ds_min:
-                    status, message = OrbitStatus.STEP_LIMIT, (f"the corrector failed at step ds < ds_min = "
-                                                               f"{opt.ds_min:g} near {param} = {unpack(v)[2]:.6g}: "
-                                                               + OrbitStatus.STEP_LIMIT.advice)
-                    break
-                continue
-            v_new, J_new, fl_new, refreshes = res
         t_new = tangent(J_new, t)
         # guard against jumping to a nearby branch: the corrector must stay close to the
         # predictor and the tangent must not turn too much in one step

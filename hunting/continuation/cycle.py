@@ -680,7 +680,13 @@ def find_cycle(system, x0=None, period_guess: float | None = None, params: dict 
     hint = None
     smap = None
     if x0 is None and period_guess is None:
-        ms = event_map_start(target, which, d_max, shooting)
+        try:
+            ms = event_map_start(target, which, d_max, shooting)
+        except (SystemDefinitionError, ConvergenceError) as e:
+            if target.loop is not None:
+                raise
+            # a model's stick family whose map cannot be evaluated somewhere: the transient decides
+            ms = MapStart(None, f"the event map of its stick phases failed ({e})")
         smap = ms.twin
         if ms.orbit is not None:
             return _result(target, ms.orbit, ms.how, shooting)
@@ -697,7 +703,7 @@ def find_cycle(system, x0=None, period_guess: float | None = None, params: dict 
                             f"< 1 there): every motion from that range ends at rest in the stick set. There is "
                             f"no cycle at these parameters: change them (e.g. the gains)", throw)
         hint = ms.hint
-        if smap is not None:
+        if smap is not None or ms.how.startswith("the event map of its stick phases failed"):
             notes.append(ms.how)
         if which == "unstable":
             # a transient never settles on an unstable cycle: shoot from the map's guess or stop
