@@ -326,3 +326,60 @@ def test_cli_warns_up_front_and_exits_1_on_divergence(capsys):
     assert "warning: the linear loop without friction is unstable" in err
     code, out, err = run_main(capsys, ["simulate", "table9.1", "--x0", "0.1,0,0", "--t", "2"])
     assert code == 0 and "warning" not in err
+
+
+# ---------------------------------------------------------------- values that start with a minus sign
+@pytest.mark.parametrize("argv, dest, expected", [
+    ("simulate table9.1 --x0 -0.1,0,0", "x0", (-0.1, 0.0, 0.0)),
+    ("simulate table9.1 --x0 -1e-1", "x0", (-0.1,)),
+    ("simulate table9.1 --x0 -.1,-2E-3", "x0", (-0.1, -2e-3)),
+    ("simulate table9.1 --x0 x1=-0.1,x3=-1", "x0", (-0.1, -1.0)),
+    ("cycle table9.1 --x0 -0.1,0,0", "x0", (-0.1, 0.0, 0.0)),
+    ("eventmap table9.1 --grid -0.5:0.5:11", "grid", -0.5),
+    ("continue table9.1 --param P --from -1e-3 --to -2.5E2 --back-to -7", "start", -1e-3),
+    ("continue table9.1 --param P --from 1 --to -2.5E2", "end", -250.0),
+    ("continue table9.1 --param P --from 1 --to 2 --back-to -.5", "back_to", -0.5),
+    ("simulate table9.1 --growth -1", "growth", -1.0),
+    ("simulate table9.1 --set P=-5", "set", [("P", "-5")]),
+])
+def test_values_may_start_with_a_minus_sign(argv, dest, expected):
+    args = hunting.cli.build_parser().parse_args(argv.split())
+    got = getattr(args, dest)
+    if dest == "x0":
+        got = got.values
+    elif dest == "grid":
+        got = got[0]
+    assert got == expected
+
+
+@pytest.mark.parametrize("argv, expected", [
+    ("cycle table9.1 --period-guess -1", "argument --period-guess: '-1' is not allowed: a finite number > 0"),
+    ("simulate table9.1 --t -1e3", "argument --t: '-1e3' is not allowed"),
+    ("simulate table9.1 --t -inf", "argument --t: '-inf' is not allowed"),
+    ("simulate table9.1 --json -o.json", "--json: expected one argument (to give a value that starts with '-', "
+                                         "write --json=-...)"),
+])
+def test_a_negative_value_where_none_is_allowed_names_the_option(capsys, argv, expected):
+    code, _, err = run_main(capsys, argv.split())
+    assert code == 2 and expected in one_line_error(err)
+
+
+def test_simulate_from_a_negative_start(capsys):
+    code, out, _ = run_main(capsys, ["simulate", "table9.1", "--x0", "-0.1,0,0", "--t", "3"])
+    assert code == 0 and out.startswith("SUCCESS")
+
+
+def test_pgf_without_tex_is_refused_before_computing(monkeypatch, capsys, tmp_path):
+    """`--plot f.pgf` needs the TeX program of matplotlib's pgf backend (was: a RuntimeError after
+    the computation, the figure lost)."""
+    import shutil
+
+    import hunting.integrate
+
+    def computed(*a, **k):
+        raise AssertionError("computed before checking the outputs")
+    monkeypatch.setattr(hunting.integrate, "simulate", computed)
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    code, _, err = run_main(capsys, ["simulate", "table9.1", "--plot", str(tmp_path / "f.pgf")])
+    line = one_line_error(err)
+    assert code == 2 and "writing .pgf needs the TeX program 'xelatex'" in line and ".png" in line

@@ -168,6 +168,11 @@ def test_reproduce_ch9_matches_the_thesis(tmp_path):
     assert run(tmp_path) == 0
     data = json.loads((tmp_path / "ch9.json").read_text())
     assert all(r["ok"] for r in data["checks"]) and len(data["checks"]) >= 30
+    facts = {r["check"]: r for r in data["checks"] if isinstance(r["ours"], bool)}
+    # a label that claims "unstable" carries True where the thesis has it unstable (Tables 9.2-9.4)
+    for label in ("d2* unstable", "beta=1: equilibrium set unstable", "beta=0.5: equilibrium set unstable",
+                  "discontinuous: equilibrium set unstable"):
+        assert facts[label]["ours"] is True and facts[label]["thesis"] is True, label
     for name in ("fig9_4", "fig9_5", "fig9_6", "fig9_7", "fig9_8", "fig11_1", "fig11_3"):
         assert (tmp_path / f"{name}.png").stat().st_size > 20000
 

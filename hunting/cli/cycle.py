@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 
+from .advice import tell
 from .boundary import UsageError, add_result_arguments, positive_float, result_files, state_spec
 from .systems import add_system_arguments, resolve_system
 
@@ -28,6 +29,12 @@ def add_arguments(p) -> None:
     p.add_argument("--which", choices=("stable", "unstable"), default="stable",
                    help="without --x0: the stable (default) or unstable cycle of the event map (presets, and "
                         "models with one Switch contact whose stick phases form a one-parameter family)")
+    p.add_argument("--t-max", dest="t_max", type=positive_float, default=None, metavar="T",
+                   help="bound on the simulated transient before shooting [s] (default 2000 period guesses, "
+                        "else 1e4)")
+    p.add_argument("--d-max", dest="d_max", type=positive_float, default=None, metavar="D",
+                   help="for a preset or a model with an event map: the largest stick error its event map is "
+                        "searched on (default: the whole range the map reaches)")
     add_result_arguments(p, "the orbit", "the orbit with its stick phases shaded")
 
 
@@ -35,7 +42,7 @@ files = result_files
 
 
 def run(args, results) -> int:
-    from ..continuation import find_cycle
+    from ..continuation import StartOptions, find_cycle
     from ..plotting import plot_cycle
     choice = resolve_system(args)
     names = list(choice.system.state_names)
@@ -44,15 +51,17 @@ def run(args, results) -> int:
         raise UsageError("--which unstable needs no --x0 (the event map of a preset or of a model with one "
                          "Switch contact), or --x0 with --period-guess (shooting from there): a simulation never "
                          "settles on an unstable cycle")
-    res = find_cycle(choice.source, x0, args.period_guess, choice.params, which=args.which)
+    start = StartOptions(t_max=args.t_max) if args.t_max is not None else None
+    res = find_cycle(choice.source, x0, args.period_guess, choice.params, which=args.which, d_max=args.d_max,
+                     start=start)
     if res.success:
-        print(res.summary())
+        print(tell(args, res.summary()))
     if args.json:
         out = res.as_dict()
         out.update(preset=choice.preset, model=getattr(args, "model", None), set=choice.overrides)
         results.write_json(args.json, out, indent=1)
     if not res.success:
-        print(f"hunting: no cycle ({res.status.name}): {' '.join(res.message.split())}", file=sys.stderr)
+        print(f"hunting: no cycle ({res.status.name}): {' '.join(tell(args, res.message).split())}", file=sys.stderr)
         return 1
     if args.plot:
         sys_ = choice.system if res.orbit is None or res.orbit.params is None else \

@@ -1,6 +1,12 @@
 """``hunting eventmap``: the stick-to-stick map P^k on a grid and its fixed points."""
 from __future__ import annotations
 
+import sys
+from collections import Counter
+
+import numpy as np
+
+from .advice import tell
 from .boundary import add_result_arguments, grid, positive_int, result_files
 from .systems import add_system_arguments, resolve_system
 
@@ -45,6 +51,14 @@ def run(args, results) -> int:
             "status": [Status(int(s)).name for s in em.status],
             "fixed_points": [f.as_dict() | {"bracketed_by_grid": f not in res.unbracketed} for f in res.fixed],
             "jumps": res.jumps}, indent=1, default=float)
+    defined = int(np.count_nonzero(em.ok))
+    if defined < 2:                     # one point (d = 0, say) is not a map: nothing was learnt
+        failed = Counter(Status(int(s)).name for s, ok in zip(em.status, em.ok) if not ok)
+        why = ", ".join(f"{name} at {k}" for name, k in failed.most_common())
+        print(tell(args, f"hunting: no map: P^{args.iterate} is defined at {defined} of {len(em.grid)} grid points "
+                         f"({why}): lower --iterate, or choose a grid where the motion reaches a stick phase "
+                         f"{args.iterate} times"), file=sys.stderr)
+        return 1
     if args.plot:
         plot_event_map(em, fixed=res.fixed, title=f"{choice.label}: P^{args.iterate}", path=args.plot)
     return 0

@@ -299,20 +299,17 @@ def stick_family(obj, *, d_state: str | None = None, seed: int = 0) -> StickFami
                                         f"{[names[i] for i in frozen]}")
         frozen = [names.index(d_state)]
     if len(frozen) != 1 or len(moving) != 1:
-        ev = ", ".join(names[i] for i in moving) or "no state"
-        fr = ", ".join(names[i] for i in frozen) or "none"
-        if not frozen and len(moving) == 1:
-            what = (f"in stick only {ev} evolves and nothing stays frozen, so every stick phase ends at the same "
-                    f"state (one break-away state: the map has a single point)")
-        elif not frozen:
-            what = (f"in stick {ev} evolve and none stays frozen (more than one free state: a stick phase is "
-                    f"not fixed by one number)")
+        evolve, stay = [names[i] for i in moving], [names[i] for i in frozen]
+        if not frozen and len(moving) <= 1:
+            what = (f"every stick phase ends at the same state (only {evolve or 'no state'} drifts and nothing "
+                    "stays frozen to tell the phases apart)")
         else:
-            what = f"in stick {ev} evolve{'s' if len(moving) == 1 else ''} and {fr} stay{'s' if len(frozen) == 1 else ''} frozen"
+            what = (f"in stick {len(evolve)} state(s) evolve ({', '.join(evolve) or 'none'}) and {len(stay)} stay "
+                    f"frozen ({', '.join(stay) or 'none'})")
         raise SystemDefinitionError(f"{name}: the stick states are not a one-parameter family: {what}; a 1-D "
                                     f"stick-exit map needs exactly one frozen state (the stick error) and one that "
-                                    f"drifts (e.g. a PID servo's position error and integral). Find its cycles with "
-                                    f"`hunting cycle` (find_cycle) instead")
+                                    f"drifts (e.g. a PID servo's position error and integral). Use find_cycle "
+                                    f"instead")
     di, ei = frozen[0], moving[0]
     # d0: the frozen value at which the drift stops (the drift is probed at two values of d)
     x = probes[0].copy()

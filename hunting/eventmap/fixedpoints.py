@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import Status
+from ..errors import Status, SystemDefinitionError
 from ..models.loop import ServoLoop
 from .engine import EventMap, MapOptions, evaluate_map, event_map
 from .family import as_stick_map
@@ -226,6 +226,19 @@ def _thesis_fit(grid, image, i):
     return r, float(np.polyval(np.polyder(np.polyfit(xs, ys, 3)), r))
 
 
+def _grid(grid) -> np.ndarray:
+    """The stick errors of a grid: at least 2 finite numbers (fixed points are bracketed
+    between neighbours), else a SystemDefinitionError naming the grid."""
+    allowed = "at least 2 finite stick errors, e.g. np.linspace(0, 0.5, 501)"
+    try:
+        g = np.asarray(grid, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise SystemDefinitionError(f"grid = {grid!r} is not allowed: {allowed}") from None
+    if g.size < 2 or not np.all(np.isfinite(g)):
+        raise SystemDefinitionError(f"grid = {grid!r} is not allowed: {allowed}")
+    return g
+
+
 def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
                  options: MapOptions | None = None, thesis_fits: bool = False,
                  emap: EventMap | None = None) -> list[FixedPoint]:
@@ -236,7 +249,7 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
     grid spans or touches 0. ``thesis_fits`` adds the thesis' local fits for comparison."""
     loop = as_stick_map(loop)            # a preset name, compiled model or PiecewiseSystem as well
     opt = options or MapOptions()
-    grid = np.asarray(grid, dtype=float).ravel()
+    grid = _grid(grid) if emap is None else emap.grid
     em = emap if emap is not None else event_map(loop, grid, iterate, derivative=False, options=opt)
     g = em.image - em.grid
     ok = em.ok

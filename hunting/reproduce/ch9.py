@@ -63,7 +63,7 @@ def run(out: Path) -> int:
     L.fact("number of cycles", len(cyc), 2)
     if len(cyc) == 2:
         L.number("d2* (unstable cycle)", cyc[0].d, 0.0034, 1e-4, "m")
-        L.fact("d2* unstable", cyc[0].stable, False)
+        L.fact("d2* unstable", not cyc[0].stable, True)
         L.number("slope of P^2 at d2*", cyc[0].slope, 1.25, 0.01)
         L.number("d3* (stable cycle)", cyc[1].d, 0.2523, 1e-4, "m")
         L.fact("d3* stable", cyc[1].stable, True)
@@ -97,7 +97,7 @@ def run(out: Path) -> int:
         results["table9.3"][name] = [f.as_dict() for f in f3]
         e3 = next(f for f in f3 if f.kind == "equilibrium")
         c3 = _cycles(f3)
-        L.fact(f"{name}: equilibrium set unstable", e3.stable, False)
+        L.fact(f"{name}: equilibrium set unstable", not e3.stable, True)
         L.fact(f"{name}: one cycle, stable", (len(c3), all(c.stable for c in c3)), (1, True))
         if c3:
             L.number(f"{name}: d2*", c3[0].d, dstar, 1e-4, "m")
