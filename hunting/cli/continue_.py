@@ -75,11 +75,37 @@ def outcome(br, param: str, start: float, end: float, back_to: float | None) -> 
     if br.status.ok and len(folds) % 2 == 1 and (last - back) * direction <= 0:
         return Outcome(0, f"the branch turns at the fold at {param} = {at_folds} and does not reach --to {end:g}; "
                           f"followed back to {param} = {last:.6g} (--back-to {back:g})", False)
+    creep = _creep(mus, param, start, end) if not br.status.ok else None
+    if creep:
+        return Outcome(1, f"stopped at {param} = {last:.6g}, short of --to {end:g} ({br.status.name}): {creep}", False)
     why = br.message if not br.status.ok else (
         f"the continuation ended after {len(folds)} fold(s)" + (f" (at {param} = {at_folds})" if folds else "")
         + f", neither at --to {end:g} nor back at {back:g}: check the folds (a singular parameter value nearby?)")
     status = "" if br.status.ok else f" ({br.status.name})"
     return Outcome(1, f"stopped at {param} = {last:.6g}, short of --to {end:g}{status}: {why}", False)
+
+
+def _creep(mus: list, param: str, start: float, end: float, min_points: int = 40) -> str | None:
+    """Why a branch that ran into a point or step limit will not get further: over the second half
+    of its points it moved always towards --to but covered less than 1 % of what the first half
+    covered (the m -> 0 branch of a belt model: steps of 1e-7 after 400 points). The family
+    approaches a limit it does not pass (a singular value such as a mass of 0); more points
+    would only crawl on. None when the branch does not creep."""
+    if len(mus) < min_points:
+        return None
+    sign = 1.0 if end > start else -1.0
+    half = len(mus) // 2
+    tail = mus[half - 1:]
+    steps = [(b - a) * sign for a, b in zip(tail, tail[1:])]
+    if min(steps) <= 0 or sum(steps) > 1e-2 * abs(mus[half - 1] - mus[0]):
+        return None
+    last = tail[-1]
+    towards_zero = last * end <= 0 and abs(last) <= 1e-2 * abs(end - start)
+    limit = (f"{param} = 0, where the model may be singular (a mass or a time constant of 0)" if towards_zero
+             else "a limit it does not pass (a singular parameter value nearby?)")
+    return (f"the branch creeps towards {limit}: its last {len(steps)} points moved {param} by {sum(steps):.2g} in "
+            f"all (the last step {steps[-1]:.2g}), and more points will not pass it. Give --to a value on this side "
+            f"(e.g. --to {last:.3g}){', and start on the other side with --from' if towards_zero else ''}")
 
 
 def _check_range(args) -> None:

@@ -709,7 +709,7 @@ def find_cycle(system, x0=None, period_guess: float | None = None, params: dict 
             # a transient never settles on an unstable cycle: shoot from the map's guess or stop
             if hint is None:
                 why = (_with_advice(ms.how, OrbitStatus.NO_CYCLE) if smap is not None else
-                       f"{ms.how}: give x0 and period_guess (--x0, --period-guess) near the unstable cycle to shoot "
+                       f"{ms.how}: give x0 and period_guess near the unstable cycle to shoot "
                        f"from there (a simulation never settles on it)")
                 return _failure(target, OrbitStatus.NO_CYCLE, why, throw)
             po = shoot(sys_, hint, ms.period, section=_section_at(sys_, hint, ms.period), options=shooting)

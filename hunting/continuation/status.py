@@ -46,25 +46,20 @@ class OrbitStatus(enum.IntEnum):
 _ADVICE = {
     OrbitStatus.SUCCESS: "converged",
     OrbitStatus.NO_RECURRENCE: ("the motion did not return periodically within the transient bound: start "
-                                "closer to the cycle (--x0 / x0), give a period guess (--period-guess / "
-                                "period_guess), or raise the bound (StartOptions(t_max=...))"),
+                                "closer to the cycle (x0), give period_guess, or raise t_max"),
     OrbitStatus.EQUILIBRIUM: ("the motion came to rest (an equilibrium or the stick set attracts this start): "
-                              "start with a larger deviation (--x0 / x0) or change the parameters"),
+                              "start with a larger deviation (x0) or change the parameters"),
     OrbitStatus.ESCAPE: ("the state grew without bound: the loop is unstable at these parameters "
                          "(no bounded cycle from this start)"),
     OrbitStatus.SINGULAR_JACOBIAN: ("the shooting Jacobian is singular: the orbit is not isolated (a family "
                                     "of cycles, e.g. a conserved quantity), grazes a switching surface, or the "
-                                    "section is tangent to the flow; start from another point of the orbit "
-                                    "(--x0 / x0)"),
-    OrbitStatus.NOT_CONVERGED: ("Newton did not converge: improve the guess (--x0 and --period-guess / x0 and "
-                                "period_guess) or loosen ShootingOptions(tol=...)"),
+                                    "section is tangent to the flow; start from another point of the orbit"),
+    OrbitStatus.NOT_CONVERGED: ("Newton did not converge: improve the guess (x0, period_guess) or loosen tol"),
     OrbitStatus.INTEGRATION_FAILED: ("an integration failed (see the integrator's status in the message): "
                                      "adjust the integration options or the parameters"),
-    OrbitStatus.POINT_LIMIT: ("the branch reached its point limit: shorten the range (--to) or raise "
-                              "ContinuationOptions(max_points=..., ds_max=...)"),
+    OrbitStatus.POINT_LIMIT: "the branch reached max_points: raise max_points or ds_max",
     OrbitStatus.STEP_LIMIT: ("the corrector failed down to the smallest step: a sharp turn, a grazing point or "
-                             "the end of the branch; restart past this point (--from) or lower "
-                             "ContinuationOptions(ds_min=...)"),
+                             "the end of the branch; lower ds_min or restart past this point"),
     OrbitStatus.NO_START: "no starting cycle was found at the first parameter value",
     OrbitStatus.NO_CYCLE: ("the event map has no cycle of this kind on the searched range: widen it (d_max), "
                            "or change the parameters"),
