@@ -224,11 +224,13 @@ def plot_map_diagram(diagram, *, title: str = "", ax=None, path=None, unit: str 
     return fig
 
 
-def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "rad", equilibrium_stable=None):
-    """Bifurcation diagram of a branch of periodic orbits (amplitude max|x1| against the
-    parameter; stable solid, unstable dashed; folds marked) above its Floquet multipliers
-    (real parts; the trivial one dotted). ``equilibrium_stable``: optional (mu, stable) arrays
-    to draw the equilibrium set x1 = 0."""
+def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str | None = None, equilibrium_stable=None):
+    """Bifurcation diagram of a branch of periodic orbits (amplitude max |x| of the first state
+    against the parameter; stable solid, unstable dashed; folds, grazing points and multiplier
+    crossings marked) above its Floquet multipliers (real parts; the trivial one dotted).
+
+    ``unit``: the first state's unit (default: the branch's ``units``; none when unknown).
+    ``equilibrium_stable``: optional (mu, stable) arrays to draw the equilibrium set x = 0."""
     plt = _plt()
     if axes is None:
         fig, axes = plt.subplots(2, 1, figsize=(7.0, 7.0), sharex=True, gridspec_kw=dict(height_ratios=[3, 2]))
@@ -236,6 +238,9 @@ def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "r
         fig = axes[0].figure
     ax, axm = axes
     mu, amp, st = branch.mu, branch.amplitude, branch.stable
+    x1 = branch.state_names[0] if branch.state_names else "x1"
+    if unit is None:
+        unit = (getattr(branch, "units", None) or {}).get(x1)
     start = 0
     for i in range(1, len(mu) + 1):
         if i == len(mu) or st[i] != st[start]:
@@ -245,14 +250,27 @@ def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "r
     if equilibrium_stable is not None:
         emu, est = equilibrium_stable
         ax.plot(emu, np.zeros_like(emu), "-" if np.all(est) else "--", color="C0", lw=2.0,
-                label="equilibrium set (x1 = 0)")
-    for s in branch.special:
-        if s.kind == "fold":
-            i = min(s.index + 1, len(mu) - 1)
-            ax.plot(s.param, amp[i], "s", color="C3", ms=7, label=f"cyclic fold {branch.param} = {s.param:.4f}")
+                label=f"equilibrium set ({x1} = 0)")
+    styles = {"fold": ("s", "C3", "cyclic fold"), "grazing": ("D", "C2", "grazing (event sequence changes)"),
+              "period_doubling": ("v", "C4", "period doubling"), "torus": ("^", "C1", "torus"),
+              "multiplier_+1": (None, None, None)}
+    shown = set()
+    for s_ in branch.special:
+        marker, color, what = styles.get(s_.kind, ("o", "C5", s_.kind))
+        if marker is None or not len(mu):
+            continue
+        i0 = min(max(s_.index, 0), len(mu) - 1)
+        i1 = min(i0 + 1, len(mu) - 1)
+        frac = (s_.param - mu[i0]) / (mu[i1] - mu[i0]) if mu[i1] != mu[i0] else 0.0
+        a = float(amp[i0] + min(max(frac, 0.0), 1.0) * (amp[i1] - amp[i0]))
+        label = (f"{what} {branch.param} = {s_.param:.4g}" if s_.kind == "fold"
+                 else (what if s_.kind not in shown else None))
+        ax.plot(s_.param, a, marker, color=color, ms=7, mfc="w" if s_.kind == "grazing" else color, mew=1.5,
+                label=label, zorder=5)
+        shown.add(s_.kind)
     ax.plot([], [], "-", color="k", label="stable cycles")
     ax.plot([], [], "--", color="k", label="unstable cycles")
-    folds = [s for s in branch.special if s.kind == "fold"]
+    folds = [s_ for s_ in branch.special if s_.kind == "fold"]
     if folds:   # magnified view of the fold, where the unstable branch starts
         k0 = folds[0].param
         sel = np.abs(mu - k0) < 0.03 * abs(k0) + 1e-12
@@ -270,7 +288,7 @@ def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "r
             ins.tick_params(labelsize=7)
             ins.grid(alpha=0.3)
             ins.set_title("near the fold", fontsize=7)
-    ax.set_ylabel(f"max |x1| [{unit}]")
+    ax.set_ylabel(f"max |{x1}|" + (f" [{unit}]" if unit else ""))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     lam = branch.multipliers
@@ -278,7 +296,8 @@ def plot_branch(branch, *, axes=None, title: str = "", path=None, unit: str = "r
         axm.plot(mu, lam[:, j].real, ":" if j == 0 else "-", lw=1.0, label=f"lambda{j + 1}")
     axm.axhline(1.0, color="0.5", lw=0.6)
     axm.set_ylim(-0.5, 3.0)
-    axm.set_xlabel(branch.param)
+    pu = (getattr(branch, "units", None) or {}).get(branch.param)
+    axm.set_xlabel(branch.param + (f" [{pu}]" if pu else ""))
     axm.set_ylabel("Floquet multipliers (real)")
     axm.grid(alpha=0.3)
     axm.legend(fontsize=8, ncol=4)
@@ -355,78 +374,169 @@ def plot_attractor_diagram(values, attractors_per_value, *, param: str = "K", ti
     return fig
 
 
-def plot_cycle(result, system, *, periods: int = 2, units: dict | None = None, title: str = "", path=None):
-    """A periodic orbit (a :class:`hunting.continuation.CycleResult`): each state over
-    ``periods`` periods from its x0 with the stick phases of every contact shaded, and a phase
-    portrait of one period with the stick segments drawn thick.
+#: per contact: (shading of its stick phases, colour of its stick segments in the portrait)
+_CONTACT_COLORS = (("0.82", "C3"), ("#f6c48f", "#d46a00"), ("#b5dcb0", "#2a8a2a"), ("#cdbde6", "#6a3fa0"))
 
-    ``system`` is the PiecewiseSystem the result belongs to (at the result's parameters).
+
+def _label(name: str, units: dict) -> str:
+    """``name [unit]`` when the unit is known, else the bare name (no unit beats a wrong one)."""
+    u = units.get(name)
+    return f"{name} [{u}]" if u else name
+
+
+def cycle_panels(result, system, model=None, *, block_states: bool = False) -> list:
+    """What :func:`plot_cycle` draws, in order: (name, kind, index) with kind "state" (index
+    into the state vector) or "signal" (a model's signal name). For a compiled model: its
+    mechanical states (the description's and the LuGre bristle states), then its block outputs
+    and friction forces; the block realizations' internal states only with ``block_states``
+    (they are an implementation of the blocks, often of size 1e-10). Otherwise every state."""
+    names = list(result.state_names)
+    if model is None or not hasattr(model, "signals"):
+        return [(k, "state", i) for i, k in enumerate(names)]
+    d = model.description
+    own = list(d.get("states", {})) + [names[c.bristle_state] for c in model.contacts if c.bristle_state is not None]
+    panels = [(k, "state", names.index(k)) for k in names if k in own]
+    sig = set(getattr(model, "signal_names", ()))
+    panels += [(b["output"], "signal", None) for b in d.get("blocks", []) if b["output"] in sig]
+    panels += [(c.force, "signal", None) for c in model.contacts if c.force in sig]
+    if block_states:
+        panels += [(k, "state", i) for i, k in enumerate(names) if k not in own]
+    return panels
+
+
+def _portrait_pair(result, panels, model) -> tuple:
+    """((name, index), (name, index)) of the phase portrait's axes."""
+    names = list(result.state_names)
+    shown = [(name, i) for name, kind, i in panels if kind == "state"] or [(k, i) for i, k in enumerate(names)]
+    if model is not None and hasattr(model, "description"):
+        eqs = model.description.get("equations", {})
+        pairs = [(k, e) for k, e in eqs.items() if e in names and k in names and k != e]
+        first = [c.surface_state for c in getattr(model, "contacts", ())][:1]
+        pairs.sort(key=lambda kv: names.index(kv[1]) not in first)
+        if pairs:
+            a, b = pairs[0]
+            return (a, names.index(a)), (b, names.index(b))
+    if len(shown) < 2:
+        return shown[0], shown[0]
+    rng = np.array([result.maximum[k] - result.minimum[k] for k, _ in shown])
+    size = np.maximum(np.array([max(abs(result.maximum[k]), abs(result.minimum[k])) for k, _ in shown]), 1e-300)
+    rel = rng / size
+    order = [k for k in range(len(shown)) if rel[k] >= 0.5 * rel.max()] + \
+            [k for k in range(len(shown)) if rel[k] < 0.5 * rel.max()]
+    return shown[order[0]], shown[order[1]]
+
+
+def plot_cycle(result, system, *, periods: int = 2, units: dict | None = None, title: str = "", path=None,
+               model=None, block_states: bool = False):
+    """A periodic orbit (a :class:`hunting.continuation.CycleResult`): each state (and, for a
+    compiled model, each block output and friction force) over ``periods`` periods from its
+    x0 with the stick phases of every contact shaded (one band per contact when there are
+    several), and a phase portrait of one period with each contact's stick segments drawn in
+    its own colour.
+
+    Parameters
+    ----------
+    result : CycleResult
+    system : PiecewiseSystem the result belongs to (at the result's parameters)
+    periods : int
+    units : mapping name -> unit text, optional
+        Added to the system's own (``system.units``, a model description's ``units``); names
+        without a unit are labelled without one.
+    model : compiled model, optional
+        Gives the panels (:func:`cycle_panels`) and signal values.
+    block_states : bool
+        Also draw the block realizations' internal states.
+
     Returns the figure; saves it when ``path`` is given."""
     from .integrate.simulate import simulate
     plt = _plt()
-    units = units or {}
+    units = {**dict(getattr(system, "units", {}) or {}), **dict(units or {})}
     T = float(result.period)
     names = list(result.state_names)
-    n = len(names)
     tr = simulate(system, result.x0_array, (0.0, periods * T), mode0=result.mode0,
                   t_eval=np.linspace(0.0, periods * T, 2000 * periods + 1), rtol=1e-10, atol=1e-13)
-    contacts = sorted({p.contact for p in result.phases})
-    colors = {c: col for c, col in zip(contacts, ("0.82", "#f2c98a", "#a9d3a5", "#c7b7e0"))}
-    fig = plt.figure(figsize=(11, 1.9 * max(n, 3) + 0.6))
+    panels = cycle_panels(result, system, model, block_states=block_states)
+    values = {}
+    if any(kind == "signal" for _, kind, _ in panels):
+        sig = [model.signals(x, t, int(m)) for t, x, m in zip(tr.t, tr.x, tr.mode)]
+        for name, kind, _ in panels:
+            if kind == "signal":
+                values[name] = np.array([s_[name] for s_ in sig])
+    for name, kind, i in panels:
+        if kind == "state":
+            values[name] = tr.x[:, i]
+    contacts = list(dict.fromkeys(p.contact for p in result.phases))
+    nc = len(contacts)
+    colors = {c: _CONTACT_COLORS[k % len(_CONTACT_COLORS)] for k, c in enumerate(contacts)}
+    if model is None and "t" not in units and getattr(system, "units", None):
+        units["t"] = "s"                              # the presets' time unit
+    n = len(panels)
+    fig = plt.figure(figsize=(11, 1.9 * max(n, 3) + 0.8))
     gs = fig.add_gridspec(n, 2, width_ratios=[1.5, 1])
-    for i, name in enumerate(names):
-        ax = fig.add_subplot(gs[i, 0])
+    for r, (name, kind, _) in enumerate(panels):
+        ax = fig.add_subplot(gs[r, 0])
         labelled = set()
-        for k in range(periods):
-            for p in result.phases:
-                if p.kind != "stick":
-                    continue
-                for a in (p.start + k * T, p.start + (k - 1) * T):      # a phase may wrap the period
-                    lo, hi = max(a, 0.0), min(a + p.duration, periods * T)
-                    if hi > lo:
-                        lab = None
-                        if i == 0 and p.contact not in labelled:
-                            lab = "stick" if len(contacts) == 1 else f"stick ({p.contact})"
-                            labelled.add(p.contact)
-                        ax.axvspan(lo, hi, color=colors[p.contact], lw=0, label=lab)
-        ax.plot(tr.t, tr.x[:, i], lw=1.0, color="C0")
+        for p in result.phases:
+            if p.kind != "stick":
+                continue
+            band = contacts.index(p.contact)
+            lo_y, hi_y = (band / nc, (band + 1) / nc) if nc > 1 else (0.0, 1.0)
+            for k in range(-1, periods):
+                a = p.start + k * T                        # a phase may wrap the period
+                lo, hi = max(a, 0.0), min(a + p.duration, periods * T)
+                if hi > lo:
+                    lab = None
+                    if r == 0 and p.contact not in labelled:
+                        where = ("lower band", "upper band")[band] if nc == 2 else f"band {band + 1} from below"
+                        lab = "stick" if nc == 1 else f"{p.contact} sticks ({where})"
+                        labelled.add(p.contact)
+                    ax.axvspan(lo, hi, ymin=lo_y, ymax=hi_y, color=colors[p.contact][0], lw=0, label=lab)
+        ax.plot(tr.t, values[name], lw=1.0, color="C0")
         for k in range(1, periods):
-            ax.axvline(k * T, color="0.4", lw=0.6, ls="--", label="period" if (i == 0 and k == 1) else None)
-        ax.set_ylabel(f"{name} [{units[name]}]" if name in units else name)
+            ax.axvline(k * T, color="0.4", lw=0.6, ls="--", label="period" if (r == 0 and k == 1) else None)
+        ax.set_ylabel(_label(name, units))
         ax.set_xlim(0.0, periods * T)
         ax.grid(alpha=0.3)
-        if i == 0:
+        if r == 0:
             ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
-        if i == n - 1:
-            ax.set_xlabel("t from x0 [s]")
-    # phase portrait: the first two states among those that move most relative to their size
-    rng = np.array([result.maximum[k] - result.minimum[k] for k in names])
-    size = np.maximum(np.array([max(abs(result.maximum[k]), abs(result.minimum[k])) for k in names]), 1e-300)
-    rel = rng / size
-    big = [k for k in range(n) if rel[k] >= 0.5 * rel.max()] + [k for k in range(n) if rel[k] < 0.5 * rel.max()]
-    i, j = (big[0], big[1]) if n >= 2 else (0, 0)
+        if r == n - 1:
+            ax.set_xlabel(_label("t from x0", {"t from x0": units.get("t")}))
+    # phase portrait: a position and its velocity (x' = v in the model's equations, the
+    # velocity of the first contact preferred), else the two shown states that move most
+    # relative to their size
+    (ni, i), (nj, j) = _portrait_pair(result, panels, model)
     ax = fig.add_subplot(gs[:, 1])
     one = tr.t <= T
-    ax.plot(tr.x[one, i], tr.x[one, j], lw=1.0, color="C0", label="slip")
-    st = np.zeros(tr.t.size, dtype=bool)
-    for p in result.phases:
-        if p.kind == "stick":
-            rel_t = (tr.t - p.start) % T
-            st |= rel_t <= p.duration
-    if np.any(st & one):
-        ax.plot(np.where(st, tr.x[:, i], np.nan)[one], np.where(st, tr.x[:, j], np.nan)[one], lw=3.0,
-                color="C3", label="stick")
-    ax.plot([result.x0[names[i]]], [result.x0[names[j]]], "o", color="k", ms=5, label="x0")
-    ax.set_xlabel(f"{names[i]} [{units[names[i]]}]" if names[i] in units else names[i])
-    ax.set_ylabel(f"{names[j]} [{units[names[j]]}]" if names[j] in units else names[j])
+    ax.plot(tr.x[one, i], tr.x[one, j], lw=1.0, color="C0", label="slip" if nc == 1 else "orbit")
+    # contacts whose surface state is on an axis are drawn last (on top) and thinnest
+    surf = {c.name: c.surface_state for c in getattr(model, "contacts", ())}
+    ranked = sorted(range(nc), key=lambda k: surf.get(contacts[k]) in (i, j))
+    for rank, k in enumerate(ranked):
+        c = contacts[k]
+        st = np.zeros(tr.t.size, dtype=bool)
+        for p in result.phases:
+            if p.kind == "stick" and p.contact == c:
+                st |= ((tr.t - p.start) % T) <= p.duration
+        st &= one
+        if np.any(st):
+            lab = "stick" if nc == 1 else f"{c} sticks"
+            xs, ys = np.where(st, tr.x[:, i], np.nan)[one], np.where(st, tr.x[:, j], np.nan)[one]
+            ax.plot(xs, ys, lw=2.0 + 2.5 * (nc - 1 - rank), color=colors[c][1], solid_capstyle="butt", label=lab)
+            # a stick phase that is a point in this plane (both states frozen) still shows
+            edges = np.flatnonzero(np.diff(np.concatenate([[0], st.astype(int), [0]])))
+            ax.plot(tr.x[edges[::2], i], tr.x[edges[::2], j], "o", color=colors[c][1], ms=6 + 2 * (nc - 1 - rank))
+    ax.plot([result.x0[ni]], [result.x0[nj]], "o", color="k", ms=5, label="x0")
+    ax.set_xlabel(_label(ni, units))
+    ax.set_ylabel(_label(nj, units))
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     lam = list(result.multipliers)
     if lam:
         lam.pop(int(np.argmin(np.abs(np.array(lam) - 1.0))))        # the trivial multiplier
-    fig.suptitle(title or f"{result.label}: {'stable' if result.stable else 'unstable'} cycle, period {T:.6g} s"
+    tu = f" {units['t']}" if units.get("t") else ""
+    fig.suptitle(title or f"{result.label}: {'stable' if result.stable else 'unstable'} cycle, period {T:.6g}{tu}"
                  + (f", largest |lambda| besides 1: {max(np.abs(lam)):.3g}" if lam else ""), fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.97))
     if path is not None:
         save(fig, path)
     return fig

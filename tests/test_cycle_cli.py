@@ -97,3 +97,28 @@ def test_continue_starts_on_the_cycle_wherever_the_map_has_it(tmp_path):
     assert main(["continue", "table9.1", "--param", "P", "--from", "10", "--to", "12", "--json", str(js)]) == 0
     pts = json.loads(js.read_text())["points"]
     assert pts[0]["amplitude"] == pytest.approx(0.2523, abs=1e-4) and pts[-1]["param"] >= 12
+
+
+def test_continue_towards_a_singular_parameter_value_says_it_creeps():
+    """Finding 11: the belt model's branch in m from 1 to -1 crawls towards m = 0 (steps of 1e-7
+    after 400 points, 5e-10 after 3000); the stop names that limit instead of 'raise
+    --max-points'. A branch with even steps that runs out of points is not called creeping."""
+    import numpy as np
+
+    from hunting.cli.continue_ import outcome
+    from hunting.continuation import Branch
+    from hunting.continuation.status import OrbitStatus
+
+    def branch(mus):
+        m = len(mus)
+        return Branch("m", np.array(mus), np.ones(m), np.ones(m), np.ones((m, 2), complex), np.ones(m, bool),
+                      np.zeros((m, 2)), [], [], OrbitStatus.POINT_LIMIT, "max_points = 400 reached")
+    crawl = list(1.0 / (1.0 + np.arange(400.0)) ** 2)                # 1 -> 6e-6, steps shrinking
+    o = outcome(branch(crawl), "m", 1.0, -1.0, None)
+    assert o.code == 1 and "creeps towards m = 0" in o.line and "--to 6.25e-06" in o.line, o.line
+    even = list(np.linspace(1.0, 0.5, 400))
+    o = outcome(branch(even), "m", 1.0, -1.0, None)
+    assert o.code == 1 and "creeps" not in o.line and "max_points = 400 reached" in o.line, o.line
+    away = list(1.0 + 1.0 / (1.0 + np.arange(400.0)) ** 2)          # creeping towards 1, not 0
+    o = outcome(branch(away), "m", 2.0, 0.5, None)
+    assert "creeps towards a limit it does not pass" in o.line and "m = 0" not in o.line, o.line

@@ -6,7 +6,8 @@
     hunting eventmap PRESET [--set NAME=VALUE ...] --grid START:STOP:N [--iterate K]
                      [--json FILE] [--plot FILE]
     hunting continue PRESET [--set NAME=VALUE ...] --param NAME --from A --to B [--back-to C]
-                     [--max-points N] [--ds-max S] [--ds-min S] [--json FILE] [--plot FILE]
+                     [--max-points N] [--ds-max S] [--ds-min S] [--x0 NAME=V,...] [--period-guess T]
+                     [--json FILE] [--plot FILE]
                                         exit 1 when the branch stops short of B
     hunting cycle PRESET [--set NAME=VALUE ...] [--x0 NAME=V,...] [--period-guess T]
                      [--which stable|unstable] [--t-max T] [--d-max D] [--json FILE] [--plot FILE]

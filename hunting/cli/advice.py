@@ -127,6 +127,12 @@ def _other_point(cmd, m):
     return m.group(0) + (f" ({' with '.join(how.split(' or '))})" if how else "")
 
 
+def _x0_and_guess(cmd, m):
+    if cmd.has("--x0") and cmd.has("--period-guess"):
+        return "give --x0 and --period-guess"
+    return f"give a start and a period guess {_python('them')}"
+
+
 def _find_cycle(cmd, m):
     return f"{m.group(1)} 'hunting cycle' instead"
 
@@ -149,6 +155,7 @@ REWRITES = [
     (r"if growth is what you study, allow more \(simulate's growth; None, or --growth 0: no check\)", _growth),
     (r"\b([Uu]se) find_cycle instead", _find_cycle),
     (r"start from another point of the orbit", _other_point),
+    (r"give x0 and period_guess", _x0_and_guess),
 ]
 _COMPILED = [(re.compile(p), f) for p, f in REWRITES]
 

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 from ..errors import SystemDefinitionError
 from .advice import tell
-from .boundary import UsageError, add_result_arguments, finite_float, positive_float, positive_int, result_files
+from .boundary import UsageError, add_result_arguments, finite_float, positive_float, positive_int, result_files, \
+    state_spec
 from .systems import add_system_arguments, resolve_system
 
 NAME = "continue"
@@ -30,6 +31,11 @@ def add_arguments(p) -> None:
     p.add_argument("--back-to", dest="back_to", type=finite_float, default=None, metavar="C",
                    help="after a fold, follow the branch back until the parameter reaches C (between A and B; "
                         "default A)")
+    p.add_argument("--x0", type=state_spec, metavar="NAME=V,...",
+                   help="where the cycle search at A starts, by name (q=0.2) or position; unnamed states start at 0 "
+                        "(default: the event map where there is one, else the model's initial values)")
+    p.add_argument("--period-guess", dest="period_guess", type=positive_float, metavar="T",
+                   help="a period guess [s] at A: shoot from --x0 first (reaches unstable cycles)")
     p.add_argument("--max-points", dest="max_points", type=positive_int, default=400, metavar="N",
                    help="bound on the branch points (default 400)")
     p.add_argument("--ds-max", dest="ds_max", type=positive_float, default=0.3, metavar="S",
@@ -69,11 +75,37 @@ def outcome(br, param: str, start: float, end: float, back_to: float | None) -> 
     if br.status.ok and len(folds) % 2 == 1 and (last - back) * direction <= 0:
         return Outcome(0, f"the branch turns at the fold at {param} = {at_folds} and does not reach --to {end:g}; "
                           f"followed back to {param} = {last:.6g} (--back-to {back:g})", False)
+    creep = _creep(mus, param, start, end) if not br.status.ok else None
+    if creep:
+        return Outcome(1, f"stopped at {param} = {last:.6g}, short of --to {end:g} ({br.status.name}): {creep}", False)
     why = br.message if not br.status.ok else (
         f"the continuation ended after {len(folds)} fold(s)" + (f" (at {param} = {at_folds})" if folds else "")
         + f", neither at --to {end:g} nor back at {back:g}: check the folds (a singular parameter value nearby?)")
     status = "" if br.status.ok else f" ({br.status.name})"
     return Outcome(1, f"stopped at {param} = {last:.6g}, short of --to {end:g}{status}: {why}", False)
+
+
+def _creep(mus: list, param: str, start: float, end: float, min_points: int = 40) -> str | None:
+    """Why a branch that ran into a point or step limit will not get further: over the second half
+    of its points it moved always towards --to but covered less than 1 % of what the first half
+    covered (the m -> 0 branch of a belt model: steps of 1e-7 after 400 points). The family
+    approaches a limit it does not pass (a singular value such as a mass of 0); more points
+    would only crawl on. None when the branch does not creep."""
+    if len(mus) < min_points:
+        return None
+    sign = 1.0 if end > start else -1.0
+    half = len(mus) // 2
+    tail = mus[half - 1:]
+    steps = [(b - a) * sign for a, b in zip(tail, tail[1:])]
+    if min(steps) <= 0 or sum(steps) > 1e-2 * abs(mus[half - 1] - mus[0]):
+        return None
+    last = tail[-1]
+    towards_zero = last * end <= 0 and abs(last) <= 1e-2 * abs(end - start)
+    limit = (f"{param} = 0, where the model may be singular (a mass or a time constant of 0)" if towards_zero
+             else "a limit it does not pass (a singular parameter value nearby?)")
+    return (f"the branch creeps towards {limit}: its last {len(steps)} points moved {param} by {sum(steps):.2g} in "
+            f"all (the last step {steps[-1]:.2g}), and more points will not pass it. Give --to a value on this side "
+            f"(e.g. --to {last:.3g}){', and start on the other side with --from' if towards_zero else ''}")
 
 
 def _check_range(args) -> None:
@@ -103,8 +135,9 @@ def run(args, results) -> int:
                          "(e.g. a mass or a time constant)"))
     ds = min(max(_DEFAULT_DS, args.ds_min), args.ds_max)
     options = ContinuationOptions(ds=ds, ds_min=args.ds_min, ds_max=args.ds_max, max_points=args.max_points)
-    br = follow(choice.source, args.param, args.start, args.end, params=choice.params, options=options,
-                stop_at=args.back_to if args.back_to is not None else args.start)
+    x0 = args.x0.vector(list(choice.system.state_names)) if args.x0 else None
+    br = follow(choice.source, args.param, args.start, args.end, params=choice.params, options=options, x0=x0,
+                period_guess=args.period_guess, stop_at=args.back_to if args.back_to is not None else args.start)
     end = outcome(br, args.param, args.start, args.end, args.back_to)
     print(f"{len(br.mu)} points: {tell(args, end.line)}")
     for s in br.special:

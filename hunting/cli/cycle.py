@@ -27,13 +27,14 @@ def add_arguments(p) -> None:
                    help="a period guess [s]: shoot from --x0 first (reaches unstable cycles), "
                         "and scale the transient by it")
     p.add_argument("--which", choices=("stable", "unstable"), default="stable",
-                   help="for a preset without --x0: the stable (default) or unstable cycle of its event map")
+                   help="without --x0: the stable (default) or unstable cycle of the event map (presets, and "
+                        "models with one Switch contact whose stick phases form a one-parameter family)")
     p.add_argument("--t-max", dest="t_max", type=positive_float, default=None, metavar="T",
                    help="bound on the simulated transient before shooting [s] (default 2000 period guesses, "
                         "else 1e4)")
     p.add_argument("--d-max", dest="d_max", type=positive_float, default=None, metavar="D",
-                   help="for a preset: the largest stick error its event map is searched on (default: the "
-                        "whole range the map reaches)")
+                   help="for a preset or a model with an event map: the largest stick error its event map is "
+                        "searched on (default: the whole range the map reaches)")
     add_result_arguments(p, "the orbit", "the orbit with its stick phases shaded")
 
 
@@ -46,9 +47,10 @@ def run(args, results) -> int:
     choice = resolve_system(args)
     names = list(choice.system.state_names)
     x0 = args.x0.vector(names) if args.x0 else None
-    if args.which == "unstable" and (x0 is not None or choice.preset is None) and args.period_guess is None:
-        raise UsageError("--which unstable needs a preset without --x0 (its event map), or --x0 with "
-                         "--period-guess (shooting from there): a simulation never settles on an unstable cycle")
+    if args.which == "unstable" and x0 is not None and args.period_guess is None:
+        raise UsageError("--which unstable needs no --x0 (the event map of a preset or of a model with one "
+                         "Switch contact), or --x0 with --period-guess (shooting from there): a simulation never "
+                         "settles on an unstable cycle")
     start = StartOptions(t_max=args.t_max) if args.t_max is not None else None
     res = find_cycle(choice.source, x0, args.period_guess, choice.params, which=args.which, d_max=args.d_max,
                      start=start)
@@ -64,5 +66,5 @@ def run(args, results) -> int:
     if args.plot:
         sys_ = choice.system if res.orbit is None or res.orbit.params is None else \
             choice.system.with_param_array(res.orbit.params)
-        plot_cycle(res, sys_, units=dict(getattr(choice.system, "units", {}) or {}), path=args.plot)
+        plot_cycle(res, sys_, model=choice.model, path=args.plot)
     return 0

@@ -17,7 +17,7 @@ bracketed between two branch points with the event counts before and after.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -26,7 +26,7 @@ from ..errors import SystemDefinitionError
 from ..results import SpecialPoint
 from ..system import PiecewiseSystem
 from .flow import Flow, flow
-from .shooting import PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude
+from .shooting import STEPS_PER_PERIOD, PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude, steps_over_event
 from .status import OrbitStatus
 
 
@@ -51,7 +51,12 @@ class ContinuationOptions:
     max(1, |lambda_2|), gets its Jacobian again, at the point, with the shooting method and
     Phi under its error control (near a fold two multipliers meet at 1 and their errors grow
     like the square root of Phi's). Flows without sensitivities run at rtol =
-    min(shooting rtol, newton_tol / 100), flows with sensitivities at 100 times that."""
+    min(shooting rtol, newton_tol / 100), flows with sensitivities at 100 times that.
+    max_step : bound on the flows' steps (the orbit's own, when smaller, is kept);
+    check_events : for systems with stick modes, each point's period is sampled (2001 points)
+    and checked for a stick guard on its firing side (:func:`missed_event`: a flow stepped over
+    a short break-away, and the point is not an orbit of the system); from such a point on the
+    flows take at most T / STEPS_PER_PERIOD per step and the point is corrected again."""
 
     ds: float = 0.05
     ds_min: float = 1e-6
@@ -69,12 +74,16 @@ class ContinuationOptions:
     jacobian_method: str | None = None
     trivial_tol: float = 1e-4
     quadratic_predictor: bool = True
+    max_step: float = np.inf
+    check_events: bool = True
 
     def __post_init__(self):
         for name in ("ds", "ds_min", "ds_max", "newton_tol", "dmu", "fold_tol", "jacobian_reuse", "trivial_tol"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise SystemDefinitionError(f"{name} = {v!r} is not allowed: it must be a finite number > 0")
+        if not self.max_step > 0:
+            raise SystemDefinitionError(f"max_step = {self.max_step!r} is not allowed: it must be > 0 (inf: no bound)")
         if self.jacobian_method not in (None, "dop853", "dp5", "radau"):
             raise SystemDefinitionError(f"jacobian_method = {self.jacobian_method!r} is not allowed: "
                                         f"use None, 'dop853', 'dp5' or 'radau'")
@@ -90,7 +99,8 @@ class Branch:
     multipliers : (m, n) complex (trivial first); stable : (m,) bool; x0 : (m, n);
     modes : list of mode sequences; special : list of SpecialPoint; status : OrbitStatus
     (SUCCESS: the run ended where asked; POINT_LIMIT, STEP_LIMIT, NO_START, INTEGRATION_FAILED);
-    message : what happened and what to change; label; state_names : names of the x0 columns."""
+    message : what happened and what to change; label; state_names : names of the x0 columns;
+    units : the system's units by name (figure labels; empty when unknown)."""
 
     param: str
     mu: np.ndarray
@@ -105,6 +115,7 @@ class Branch:
     message: str
     label: str = ""
     state_names: tuple = ()
+    units: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         names = self.state_names or tuple(f"x{i + 1}" for i in range(self.x0.shape[1] if self.x0.ndim == 2 else 0))
@@ -133,6 +144,39 @@ def _nontrivial_near(lam, target):
     rest = lam[1:]
     k = int(np.argmin(np.abs(rest - target)))
     return rest[k]
+
+
+def mode_cycle(fl: Flow, T: float, min_fraction: float = 1e-9) -> tuple:
+    """The orbit's event structure as a cyclic sequence of modes, independent of where on the
+    orbit the flow started: mode stretches shorter than ``min_fraction`` T dropped (a start
+    on a switching surface passes through a mode for no time), repeats merged, the two ends
+    joined, and the sequence rotated to its smallest form. Two orbits have the same structure
+    exactly when these agree (the number of events per period is its length).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from hunting.continuation.branch import mode_cycle
+    >>> class F: pass
+    >>> a, b = F(), F()
+    >>> a.modes, a.event_times = np.array([2, 1, 2]), np.array([1.0, 3.0])
+    >>> b.modes, b.event_times = np.array([0, 2, 1, 2]), np.array([0.0, 1.0, 3.0])
+    >>> mode_cycle(a, 5.0), mode_cycle(b, 5.0)
+    ((1, 2), (1, 2))
+    """
+    modes = [int(m) for m in fl.modes]
+    bounds = np.concatenate([[0.0], np.asarray(fl.event_times, dtype=float), [float(T)]])
+    seq = []
+    for m, dur in zip(modes, np.diff(bounds)[:len(modes)]):
+        if dur <= min_fraction * T:
+            continue
+        if not seq or seq[-1] != m:
+            seq.append(m)
+    if len(seq) > 1 and seq[0] == seq[-1]:
+        seq.pop()
+    if not seq:
+        return ()
+    return min(tuple(seq[k:] + seq[:k]) for k in range(len(seq)))
 
 
 def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: PeriodicOrbit, mu0: float,
@@ -183,7 +227,8 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     # a residual flow's error must stay below the corrector's tolerance: rtol <= newton_tol / 100
     rtol_res = min(sopt.rtol, 1e-2 * opt.newton_tol)
     kw_res = dict(method=sopt.method, rtol=rtol_res, atol=rtol_res * sopt.atol / sopt.rtol,
-                  max_events=sopt.max_events, max_steps=sopt.max_steps)
+                  max_events=sopt.max_events, max_steps=sopt.max_steps,
+                  max_step=min(opt.max_step, sopt.max_step, getattr(orbit, "max_step", np.inf)))
     # two accuracies: residual flows (no sensitivities) at rtol_res; flows with sensitivities
     # (the corrector's Jacobians, the points' multipliers and tangents) at 100 rtol_res: they
     # only steer the corrector and give the multipliers, every residual is a flow of its own
@@ -318,7 +363,25 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             J, fl = out[1], out[2]
         return v, J, fl, refreshes
 
+    sticks = opt.check_events and any(m.kind in ("stick", "filippov") for m in system_at(mu0).modes)
+    capped_at = []                  # the parameter value from which the flows' steps were bounded
+
+    def missed(v):
+        """Whether the flow of point v stepped over a short event; if so, bound the steps of
+        every later flow (kw_res, kw_jac) to T / STEPS_PER_PERIOD."""
+        if not sticks:
+            return False
+        x, T, mu = unpack(v)
+        h = T / STEPS_PER_PERIOD
+        if kw_res["max_step"] <= h or not steps_over_event(system_at(mu), x, T, method=sopt.method,
+                                                           max_step=kw_res["max_step"]):
+            return False
+        kw_res["max_step"] = kw_jac["max_step"] = h
+        capped_at.append(mu)
+        return True
+
     v = np.concatenate([orbit.x0[free], [orbit.period, mu0]]) / scale
+    missed(v)
     out = residual_and_jac(v)
     if out is None:
         n_par = len(system_at(mu0).params)
@@ -358,6 +421,9 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             # needs to recompute it
             J_pred = J + (J - J_prev) * (ds / float(np.linalg.norm(v - pts_v[-2])))
         res = correct(v_pred, t, J_pred)
+        if res is not None and missed(res[0]):
+            # the point is not an orbit of the system: correct it again with bounded steps
+            res = correct(res[0], t, res[1], reuse=False)
         if res is None:
             ds *= 0.5
             if ds < opt.ds_min:
@@ -375,6 +441,20 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             ds *= 0.5
             continue
         mu_new = unpack(v_new)[2]
+        if mu_new < lo or mu_new > hi:
+            # the step passed the end of the range: the last point lands on it exactly
+            # (a corrector with the parameter held at the end, from the chord's point there)
+            mu_end_hit = hi if mu_new > hi else lo
+            mu_old = unpack(v)[2]
+            if mu_new != mu_old:
+                e_mu = np.zeros_like(v)
+                e_mu[-1] = 1.0
+                frac = (mu_end_hit - mu_old) / (mu_new - mu_old)
+                land = correct(v + frac * (v_new - v), e_mu, J_new)
+                if land is not None and abs(unpack(land[0])[2] - mu_end_hit) <= 1e-9 * max(abs(mu_end_hit), 1e-12):
+                    v_new, J_new, fl_new, _ = land
+                    t_new = tangent(J_new, t)
+                    mu_new = unpack(v_new)[2]
         # the next step from the corrector's work (a Jacobian recomputed more than once: the
         # predictor was too far) and the tangent's turn (no more than half of max_angle)
         turn = float(np.arccos(np.clip(np.dot(t_new, t), -1.0, 1.0)))
@@ -384,14 +464,18 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             sp = _refine_fold(lambda vp, tp: correct(vp, tp, J, reuse=False), tangent, unpack, v, t, ds, opt, len(pts_v) - 1)
             special.append(sp)
             turns += 1
-        if tuple(fl_new.modes) != tuple(fl.modes) and len(fl_new.modes) != len(fl.modes):
+        sig_old, sig_new = mode_cycle(fl, unpack(v)[1]), mode_cycle(fl_new, unpack(v_new)[1])
+        if sig_old != sig_new:
+            names = [m.name for m in system_at(mu_new).modes]
             special.append(SpecialPoint("grazing", len(pts_v) - 1, 0.5 * (unpack(v)[2] + mu_new),
                                         tuple(sorted((unpack(v)[2], mu_new))), abs(mu_new - unpack(v)[2]),
-                                        {"events_before": len(fl.modes) - 1, "events_after": len(fl_new.modes) - 1}))
+                                        {"events_before": len(sig_old), "events_after": len(sig_new),
+                                         "modes_before": [names[m] for m in sig_old],
+                                         "modes_after": [names[m] for m in sig_new]}))
         v, t, fl, J, J_prev = v_new, t_new, fl_new, J_new, J
         pts_v.append(v)
         pts_fl.append(fl)
-        if mu_new < lo or mu_new > hi:
+        if mu_new <= lo or mu_new >= hi:
             break
         if turns >= max_turns and stop_at_mu is not None:
             if (t[-1] < 0 and mu_new <= stop_at_mu) or (t[-1] > 0 and mu_new >= stop_at_mu):
@@ -410,7 +494,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         stab.append(bool(np.all(np.abs(lam[1:]) < 1.0)))
         modes.append(tuple(int(m) for m in ff.modes))
         amps.append(amplitude(system_at(mu), x, T, ff) if amplitude is not None
-                    else orbit_amplitude(system_at(mu), x, T, method=sopt.method))
+                    else orbit_amplitude(system_at(mu), x, T, method=sopt.method, max_step=kw_res["max_step"]))
     lams = np.array(lams)
     # multiplier crossings: changes in the number of non-trivial multipliers outside the unit
     # circle through +1 (fold), through -1 (period doubling) or as a complex pair (torus)
@@ -419,8 +503,16 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         real = np.abs(rest.imag) < 1e-9 * np.maximum(1.0, np.abs(rest))
         return (int(np.sum(real & (rest.real > 1))), int(np.sum(real & (rest.real < -1))),
                 int(np.sum(~real & (np.abs(rest) > 1))))
+    cycles = [mode_cycle(ff, T) for ff, T in zip(pts_fl, Ts)]
     for i in range(len(mus) - 1):
         ca, cb = counts(lams[i]), counts(lams[i + 1])
+        if cycles[i] != cycles[i + 1]:
+            # the multipliers jump where the event sequence changes (a nonsmooth point): not a
+            # smooth crossing; the grazing point carries the counts
+            for sp in special:
+                if sp.kind == "grazing" and sp.index == i and (ca != cb):
+                    sp.data.update(unstable_before=int(sum(ca)), unstable_after=int(sum(cb)))
+            continue
         for j, kind, target in ((0, "multiplier_+1", 1.0), (1, "period_doubling", -1.0), (2, "torus", None)):
             if ca[j] != cb[j]:
                 lo_mu, hi_mu = sorted((mus[i], mus[i + 1]))
@@ -434,8 +526,43 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
                     data.update(multiplier_before=a, multiplier_after=b)
                 special.append(SpecialPoint(kind, i, float(est), (lo_mu, hi_mu), hi_mu - lo_mu, data))
     special.sort(key=lambda s: s.index)
+    special = _merge_grazing(special)
+    g = special[-1] if special else None
+    if (status == OrbitStatus.STEP_LIMIT and g is not None and g.kind == "grazing"
+            and abs(mus[-1] - g.param) <= max(100 * g.precision, 1e-3 * abs(mu_end - mu0))):
+        message = (f"the corrector failed at step ds < ds_min = {opt.ds_min:g} at a grazing point near {param} = "
+                   f"{g.param:.6g}, where the event sequence changes ({' -> '.join(g.data['modes_before'])} to "
+                   f"{' -> '.join(g.data['modes_after'])}): the branch is not smooth there. Restart the "
+                   f"continuation past it (a cycle found at a parameter value beyond) to follow the other side")
+    if capped_at:
+        message += (f" (from {param} = {capped_at[0]:.6g} on, flows with steps of at most T / {STEPS_PER_PERIOD}: "
+                    f"one had stepped over a short event)")
+    sys0 = system_at(mu0)
     return Branch(param, np.array(mus), np.array(Ts), np.array(amps), lams, np.array(stab), np.array(xs), modes,
-                  special, status, message, state_names=tuple(system_at(mu0).state_names))
+                  special, status, message, state_names=tuple(sys0.state_names), units=dict(sys0.units or {}))
+
+
+def _merge_grazing(special: list) -> list:
+    """Join grazing points at consecutive branch points that switch back and forth between the
+    same two event sequences (the corrector straddling one nonsmooth point) into one, whose
+    interval covers them all (``data["crossings"]``: how many switches)."""
+    out = []
+    for sp in special:
+        prev = out[-1] if out else None
+        if (sp.kind == "grazing" and prev is not None and prev.kind == "grazing"
+                and sp.index - prev.data.get("last_index", prev.index) <= 6
+                and {tuple(sp.data["modes_before"]), tuple(sp.data["modes_after"])}
+                == {tuple(prev.data["modes_before"]), tuple(prev.data["modes_after"])}):
+            lo = min(prev.interval[0], sp.interval[0])
+            hi = max(prev.interval[1], sp.interval[1])
+            data = dict(prev.data, crossings=prev.data.get("crossings", 1) + 1, last_index=sp.index)
+            out[-1] = SpecialPoint("grazing", prev.index, 0.5 * (lo + hi), (lo, hi), hi - lo, data)
+            continue
+        out.append(sp)
+    for k, sp in enumerate(out):
+        if sp.kind == "grazing" and "last_index" in sp.data:
+            sp.data.pop("last_index")
+    return out
 
 
 def _refine_fold(correct, tangent, unpack, v0, t0, ds, opt, index):

@@ -38,13 +38,20 @@ class Flow:
 def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, params=None,
          method: str = "dop853", rtol: float = 1e-11, atol: float = 1e-13, sensitivity: bool = True,
          max_steps: int = 500_000, max_events: int = 10_000, guard_tol: float = 1e-12,
-         stop_mode: int = -1, stop_count: int = 1, param_direction=None) -> Flow:
+         stop_mode: int = -1, stop_count: int = 1, param_direction=None, max_step: float = np.inf) -> Flow:
     """Integrate over [0, T] (or until the stop condition) with the fundamental matrix Phi.
+
+    max_step : bound on the step [time unit] (events are found where a guard changes sign
+    between steps: a guard that dips through zero and back within one step goes unseen, e.g.
+    a short break-away while another part of the system moves fast).
 
     param_direction : (len(params),) d params / d mu of a scalar parameter mu: the parameter
     sensitivity d x(T) / d mu is integrated with Phi (variational column with forcing f_mu,
     event terms from the guards' and transitions' mu-derivatives) and returned as dx_dmu."""
     x0 = system.check_state(x0)
+    hmax = float(max_step)
+    if not hmax > 0:
+        raise SystemDefinitionError(f"max_step = {max_step!r} is not allowed: it must be > 0 (inf: no bound)")
     if not (np.isfinite(T) and T > 0):
         raise SystemDefinitionError(f"T = {T!r} is not allowed: the period must be a finite number > 0")
     n = system.n_states
@@ -74,7 +81,7 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
     nf, ni = K.workspace_sizes(N, n, system.n_guards, system.n_modes, 50)
     K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
                        system.jacobian is not None, METHODS[method], n, 0.0, float(T), y0,
-                       -1 if mode0 is None else int(mode0), p, dpw, system.directions, rtol, atol, 0.0, np.inf,
+                       -1 if mode0 is None else int(mode0), p, dpw, system.directions, rtol, atol, 0.0, hmax,
                        int(max_steps), int(max_events), guard_tol, False, np.empty(0), False, int(stop_mode),
                        int(stop_count), 50, 1e-12 * T, out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f,
                        ev_to, info, finfo, yf, np.empty(nf), np.empty(ni, dtype=np.int64))

@@ -72,8 +72,8 @@ def follow(system, param: str, start: float, end: float, *, params: dict | None 
         if not isinstance(v, (int, float, np.floating)) or not np.isfinite(v):
             raise SystemDefinitionError(f"{name} = {v!r} is not allowed: it must be a finite number")
     if start == end:
-        raise SystemDefinitionError(f"start = end = {start!r}: the parameter range is empty; give the start "
-                                    f"(--from) and the end (--to) of the range different values")
+        raise SystemDefinitionError(f"start = end = {start!r}: the parameter range is empty; give its start and "
+                                    f"end (on the command line --from and --to) different values")
     params = dict(params or {})
     if param in params:
         raise SystemDefinitionError(f"param = {param!r} is also given in params: remove it there")

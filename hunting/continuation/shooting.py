@@ -7,7 +7,8 @@ as stable ones.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -22,7 +23,9 @@ from .status import OrbitStatus
 class ShootingOptions:
     """tol : Newton stops when the scaled residual max|r_i| / scale_i <= tol (scale_i =
     max(|x0_i|, floor)); max_iter : Newton iterations; rtol, atol, method : integration;
-    floor : absolute floor of the state scales."""
+    floor : absolute floor of the state scales; max_step : bound on the integration step
+    [time unit] (inf: none; :func:`hunting.continuation.find_cycle` sets one when a flow
+    stepped over a short event)."""
 
     tol: float = 1e-9
     max_iter: int = 30
@@ -32,8 +35,11 @@ class ShootingOptions:
     floor: float = 1e-6
     max_events: int = 10_000
     max_steps: int = 1_000_000
+    max_step: float = math.inf
 
     def __post_init__(self):
+        if not self.max_step > 0:
+            raise SystemDefinitionError(f"max_step = {self.max_step!r} is not allowed: it must be > 0 (inf: no bound)")
         for name in ("tol", "rtol", "atol", "floor"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
@@ -52,7 +58,8 @@ class PeriodicOrbit:
     max |x1| over the orbit; stable : every non-trivial |lambda| < 1; status : OrbitStatus;
     message : what happened and, on failure, what to change; iterations : Newton iterations;
     residual : final scaled residual; params : the flat parameter array of the orbit;
-    section : the state held fixed by the phase condition (x0[section] is on the section)."""
+    section : the state held fixed by the phase condition (x0[section] is on the section);
+    max_step : the step bound its flows used (continuation keeps it)."""
 
     x0: np.ndarray
     period: float
@@ -69,6 +76,7 @@ class PeriodicOrbit:
     residual: float
     params: np.ndarray = field(repr=False, default=None)
     section: int = 0
+    max_step: float = math.inf
 
     @property
     def success(self) -> bool:
@@ -93,14 +101,57 @@ def floquet(M: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, float]:
     return np.concatenate([[lam[k]], rest]), float(abs(lam[k] - 1.0))
 
 
-def orbit_amplitude(system: PiecewiseSystem, x0, T, params=None, n: int = 4001, method="dop853") -> float:
+def orbit_amplitude(system: PiecewiseSystem, x0, T, params=None, n: int = 4001, method="dop853",
+                    max_step: float = math.inf) -> float:
     """max |x1| over one period, from output at n points plus every event state."""
     sys_ = system if params is None else system.with_param_array(params)
-    tr = simulate(sys_, x0, (0.0, T), t_eval=np.linspace(0.0, T, n), rtol=1e-10, atol=1e-13, method=method)
+    tr = simulate(sys_, x0, (0.0, T), t_eval=np.linspace(0.0, T, n), rtol=1e-10, atol=1e-13, method=method,
+                  max_step=max_step)
     a = np.max(np.abs(tr.x[:, 0]))
     if len(tr.events):
         a = max(a, np.max(np.abs(tr.events.x_before[:, 0])))
     return float(a)
+
+
+#: steps per period of the flows of an orbit whose flow stepped over a short event
+STEPS_PER_PERIOD = 2000
+
+
+def missed_event(system: PiecewiseSystem, tr, rel: float = 1e-6) -> bool:
+    """True when a sampled trajectory has a guard on its firing side inside a mode (beyond
+    ``rel`` of that guard's largest magnitude along the trajectory): the integration stepped
+    over a short event (a guard that dipped through zero and back within one step, e.g. a
+    short break-away while another mass moves fast; the kernel finds events where a guard
+    changes sign between steps).
+
+    Parameters
+    ----------
+    system : PiecewiseSystem (with the trajectory's parameters)
+    tr : Trajectory sampled densely (e.g. ``t_eval`` at a few thousand points per period)
+    rel : float
+    """
+    n = len(tr.t)
+    if n == 0:
+        return False
+    G = np.empty((n, system.n_guards))
+    out = np.empty(system.n_guards)
+    for k in range(n):
+        system.guards(int(tr.mode[k]), float(tr.t[k]), np.ascontiguousarray(tr.x[k]), system.params, out)
+        G[k] = out
+    fire = system.directions[tr.mode.astype(np.int64)]
+    tol = rel * np.maximum(np.max(np.abs(G), axis=0), 1e-300)
+    wrong = ((fire < 0) & (G < -tol)) | ((fire > 0) & (G > tol))
+    return bool(np.any(wrong))
+
+
+def steps_over_event(system: PiecewiseSystem, x0, T: float, *, params=None, method: str = "dop853",
+                     max_step: float = math.inf, n: int = 2001) -> bool:
+    """Whether the flow over one period from x0 (at max_step) stepped over a short event:
+    :func:`missed_event` on a simulation sampled at n points."""
+    sys_ = system if params is None else system.with_param_array(params)
+    tr = simulate(sys_, x0, (0.0, T), t_eval=np.linspace(0.0, T, n), rtol=1e-10, atol=1e-13, method=method,
+                  max_step=max_step)
+    return missed_event(sys_, tr)
 
 
 def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
@@ -151,7 +202,7 @@ def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
     scale = np.append(np.maximum(np.maximum(np.abs(x), 0.1 * np.max(np.abs(x))), opt.floor), max(T, 1e-12))
     T = float(T)
     kw = dict(params=p, method=opt.method, rtol=opt.rtol, atol=opt.atol, max_events=opt.max_events,
-              max_steps=opt.max_steps)
+              max_steps=opt.max_steps, max_step=opt.max_step)
 
     def evaluate(xv, Tv, sensitivity=True):
         fl = flow(system, xv, Tv, sensitivity=sensitivity, **kw)
@@ -213,12 +264,70 @@ def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
             status, message = OrbitStatus.EQUILIBRIUM, ("converged to an equilibrium (the vector field vanishes "
                                                      "on the orbit): start closer to the cycle")
     mult, triv = (floquet(fl.Phi, fl.f) if fl.ok else (np.full(n, np.nan + 0j), np.nan))
-    amp = orbit_amplitude(system, x, T, p, method=opt.method) if status == OrbitStatus.SUCCESS else np.nan
+    amp = orbit_amplitude(system, x, T, p, method=opt.method, max_step=opt.max_step) if status == OrbitStatus.SUCCESS else np.nan
     stable = bool(np.all(np.abs(mult[1:]) < 1.0)) if status == OrbitStatus.SUCCESS else False
     orbit = PeriodicOrbit(x, float(T), tuple(int(m) for m in fl.modes), fl.event_times, fl.Phi, mult, triv, amp,
-                          stable, status, message, it, res, p, section)
+                          stable, status, message, it, res, p, section, opt.max_step)
     if throw and status != OrbitStatus.SUCCESS:
         raise ConvergenceError(f"{system.name}: shooting failed: {message}", orbit)
+    return orbit
+
+
+def minimal_period(system: PiecewiseSystem, orbit: PeriodicOrbit, options: ShootingOptions | None = None, *,
+                   max_divisor: int = 8, tol: float = 1e-6) -> PeriodicOrbit:
+    """The orbit at its minimal period.
+
+    Shooting converges on a state x0 with phi(T; x0) = x0, which also holds at every multiple
+    of the minimal period (a transient whose returns p apart agree can hand it 2T; the
+    multipliers of 2T are the squares of the true ones). For k = max_divisor, ..., 2 the flow
+    from x0 over T / k is compared with x0 (max-norm, each state scaled as in shooting); the
+    largest k that returns within ``tol`` gives the minimal period T / k, and the orbit is
+    shot again there (one or two Newton steps) for its own monodromy matrix.
+
+    Parameters
+    ----------
+    system : PiecewiseSystem
+    orbit : PeriodicOrbit (converged)
+    options : ShootingOptions of the re-shooting
+    max_divisor : int
+        Largest k tried.
+    tol : float
+        Scaled distance below which x(T / k) counts as a return to x0.
+
+    Returns
+    -------
+    PeriodicOrbit
+        ``orbit`` itself when T is already minimal (or re-shooting at T / k fails).
+
+    Examples
+    --------
+    The chapter-8 Switch cycle handed twice its period:
+
+    >>> from hunting import preset
+    >>> from hunting.continuation import shoot
+    >>> from hunting.continuation.shooting import minimal_period
+    >>> sys_ = preset("table8.1-switch", K=0.3).system
+    >>> po = shoot(sys_, [0.0, 0.079, -0.0166], 14.3)
+    >>> po2 = shoot(sys_, po.x0, 2 * po.period)
+    >>> round(po2.period / po.period, 6), round(minimal_period(sys_, po2).period / po.period, 6)
+    (2.0, 1.0)
+    """
+    if not orbit.success:
+        return orbit
+    opt = options or ShootingOptions()
+    x0 = np.asarray(orbit.x0, dtype=float)
+    p = orbit.params if orbit.params is not None else system.params
+    scale = np.maximum(np.maximum(np.abs(x0), 0.1 * np.max(np.abs(x0))), opt.floor)
+    for k in range(int(max_divisor), 1, -1):
+        Tk = orbit.period / k
+        fl = flow(system, x0, Tk, params=p, sensitivity=False, method=opt.method, rtol=opt.rtol, atol=opt.atol,
+                  max_events=opt.max_events, max_steps=opt.max_steps, max_step=opt.max_step)
+        if not fl.ok or np.max(np.abs(fl.x - x0) / scale) > tol:
+            continue
+        po = shoot(system, x0, Tk, section=orbit.section, params=p, options=opt)
+        if po.success and abs(po.period - Tk) <= 1e-6 * Tk:
+            return replace(po, message=f"{po.message} (at the minimal period: the period first found, "
+                                       f"{orbit.period:.8g}, holds {k} of them)")
     return orbit
 
 

@@ -133,7 +133,8 @@ class CompiledModel:
                 name=spec.name, state_names=self.layout.state_names, modes=tuple(modes),
                 guard_names=tuple(meta["guard_names"]), param_names=self.layout.param_names,
                 params=params if len(params) else np.zeros(1), vector_field=module.vf, guards=module.guards,
-                transition=module.reset, mode_of=module.mode_of, jacobian=module.jac)
+                transition=module.reset, mode_of=module.mode_of, jacobian=module.jac,
+                units=dict(spec.description.get("units", {})))
         self.system = system
 
     # ------------------------------------------------------------------ names and layout

@@ -8,7 +8,8 @@ The description (the same in JSON, YAML and Python)::
      "signals": {"u": "-k*q"},                         # name -> expression (any order, no cycles)
      "equations": {"q": "v", "v": "(u - F)/m"},        # one right-hand side per state
      "friction": {...} or [{...}, ...],                # contacts (below), optional
-     "blocks": [{...}, ...]}                           # linear blocks (below), optional
+     "blocks": [{...}, ...],                           # linear blocks (below), optional
+     "units": {"q": "m", "v": "m/s", "F": "N", "t": "s"}}  # optional: figure labels only
 
 A friction contact::
 
@@ -51,7 +52,7 @@ MAX_CONTACTS = 4
 MAX_PADE_ORDER = 10
 SLIP_VARIABLE = "w"
 TF_VARIABLE = "s"
-_TOP_KEYS = ("name", "parameters", "states", "signals", "equations", "friction", "blocks")
+_TOP_KEYS = ("name", "parameters", "states", "signals", "equations", "friction", "blocks", "units")
 _SWITCH_KEYS = ("name", "force", "velocity", "model", "slip", "stick")
 _LUGRE_KEYS = ("name", "force", "velocity", "model", "level", "sigma0", "sigma1", "viscous", "state", "z0")
 _RESERVED = set(FUNCTIONS) | set(CONSTANTS) | {TIME}
@@ -120,6 +121,7 @@ class Spec:
         initial values or the name (those live in arrays and labels, so they never recompile)."""
         d = dict(self.description)
         d.pop("name", None)
+        d.pop("units", None)            # labels only
         d["parameters"] = list(d["parameters"])
         d["states"] = list(d["states"])
         for c in d.get("friction", []):
@@ -379,15 +381,39 @@ def validate(desc) -> Spec:
             contacts.append(ContactSpec(cn, "lugre", c["force"], vel, level=lug["level"], sigma0=lug["sigma0"],
                                         sigma1=lug["sigma1"], viscous=visc, state=st, z0=float(z0)))
 
+    units = _units(desc.get("units"), set(taken) | {TIME})
+
     norm = {"name": name, "parameters": dict(params), "states": dict(initial),
             "signals": {k: e.canonical for k, e in signals.items()},
             "equations": {k: e.canonical for k, e in equations.items()},
             "friction": [_contact_dict(c) for c in contacts],
             "blocks": [_block_dict(b) for b in blocks]}
+    if units:
+        norm["units"] = units
     spec = Spec(name, params, tuple(states), initial, signals, tuple(order), equations, tuple(contacts),
                 tuple(blocks), norm)
     spec.check_parameter_values(params)
     return spec
+
+
+def _units(raw, names: set) -> dict:
+    """The optional ``units`` map: name (a state, parameter, signal, block output, friction
+    force or t) -> unit text (figure and table labels only; nothing is converted)."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise SystemDefinitionError(f"units = {raw!r} must be a mapping name -> unit text, e.g. "
+                                    f"{{\"q\": \"m\", \"t\": \"s\"}}")
+    out = {}
+    for k, v in raw.items():
+        if k not in names:
+            raise SystemDefinitionError(f"units[{k!r}]: {k!r} is not a name of this model (allowed: states, "
+                                        f"parameters, signals, block outputs, friction forces, t)")
+        if not isinstance(v, str) or len(v) > 40 or any(ch in v for ch in "\n\r\t"):
+            raise SystemDefinitionError(f"units[{k!r}] = {v!r} is not allowed: give the unit as a short text "
+                                        f"(at most 40 characters), e.g. \"m/s\"")
+        out[str(k)] = v
+    return out
 
 
 def _block(b, i, everything, params, what) -> BlockSpec:

@@ -149,6 +149,39 @@ class StickFamily:
         mode = int(sys_.transition(int(self.stick_mode), int(i), 0.0, xr, sys_.params, out))
         return xr, mode
 
+    def force_scale(self) -> float:
+        """The stick error whose stick force alone (drift state at 0) reaches a bound of the
+        stick set: the smallest |d| > 0 at which a stick guard vanishes (for a PID servo
+        Fs / kp, the scale of its event map); 1.0 when no guard vanishes along d.
+
+        Examples
+        --------
+        >>> from hunting import preset
+        >>> from hunting.eventmap import stick_family
+        >>> round(stick_family(preset("table9.1").system).force_scale(), 12)
+        0.4
+        """
+        sys_ = self.system
+        best = math.inf
+        for i in range(sys_.n_guards):
+            def g(d, i=i):
+                x = self._base()
+                x[self.d_state] = self.d0 + d
+                return self._guards(x)[i]
+            for sign in (1.0, -1.0):
+                a, b = 0.0, sign * float(self._scale[self.d_state])
+                ga, gb = g(a), g(b)
+                for _ in range(60):
+                    if gb == ga or not math.isfinite(gb):
+                        break
+                    c = b - gb * (b - a) / (gb - ga)
+                    a, ga, b, gb = b, gb, c, g(c)
+                    if abs(gb) <= 1e-13 * (abs(ga) + 1.0) or abs(b - a) <= 1e-15 * (abs(b) + 1.0):
+                        break
+                if math.isfinite(b) and abs(g(b)) <= 1e-9 * (abs(g(0.0)) + 1.0) and b * sign > 0:
+                    best = min(best, abs(b))
+        return float(best) if math.isfinite(best) else 1.0
+
     def stick_error(self, X) -> np.ndarray:
         """d of states X (m, n): x[d_state] - d0."""
         return np.atleast_2d(X)[:, self.d_state] - self.d0
@@ -275,7 +308,8 @@ def stick_family(obj, *, d_state: str | None = None, seed: int = 0) -> StickFami
                     f"frozen ({', '.join(stay) or 'none'})")
         raise SystemDefinitionError(f"{name}: the stick states are not a one-parameter family: {what}; a 1-D "
                                     f"stick-exit map needs exactly one frozen state (the stick error) and one that "
-                                    f"drifts (e.g. a PID servo's position error and integral). Use find_cycle instead")
+                                    f"drifts (e.g. a PID servo's position error and integral). Use find_cycle "
+                                    f"instead")
     di, ei = frozen[0], moving[0]
     # d0: the frozen value at which the drift stops (the drift is probed at two values of d)
     x = probes[0].copy()
