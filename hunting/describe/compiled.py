@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import SystemDefinitionError, check_finite
 from ..system import Mode, PiecewiseSystem
 from . import cache
-from .description import GENERATOR_VERSION, Spec
+from .description import GENERATOR_VERSION, SLIP_VARIABLE, Spec
 from .expressions import TIME, evaluate, first_non_finite, parse
 
 PART_NAMES = ("slip+", "slip-", "stick")
@@ -283,7 +283,7 @@ class CompiledModel:
         the order they are computed), then each contact's velocity and force, then the
         equations: the first one named is the cause, the later ones inherit it.
 
-        For example ``"equations['v'] = '(u - F)/m' is inf at t = 0: division by m = 0"``."""
+        For example ``"equations['v'] = '(u - F)/m' is not finite: division by m = 0"``."""
         spec = self._spec
         x = np.ascontiguousarray(x, dtype=np.float64)
         p = np.ascontiguousarray(p, dtype=np.float64)
@@ -297,7 +297,7 @@ class CompiledModel:
             detail = first_non_finite(expr, {**values, **(extra or {})})
             if detail is None:
                 return None
-            return f"{where} = {expr.text!r} is not finite at t = {float(t):.6g}: {detail}"
+            return f"{where} = {expr.text!r} is not finite: {detail}"
 
         for k in spec.signal_order:
             if k in spec.signals and not math.isfinite(values[k]):
@@ -306,7 +306,7 @@ class CompiledModel:
                     return text
         for b in spec.blocks:
             if not math.isfinite(values[b.output]):
-                return (f"the output of blocks[{b.output!r}] is {values[b.output]} at t = {float(t):.6g} "
+                return (f"the output of blocks[{b.output!r}] is {values[b.output]} "
                         f"(its input {b.input.text!r} = {evaluate_or_nan(b.input, values):.6g})")
         for c, cc in zip(spec.contacts, self.contacts):
             w = float(self._module._w(cc.index, float(t), x, p))
@@ -319,10 +319,10 @@ class CompiledModel:
                     if c.model == "switch" else [("level", c.level), ("sigma0", c.sigma0), ("sigma1", c.sigma1),
                                                  ("viscous", c.viscous)]
                 for key, e in laws:
-                    text = why(f"{name}.{key}", e, {"w": w})
+                    text = why(f"{name}.{key}", e, {SLIP_VARIABLE: w})
                     if text:
                         return text
-                return f"the friction force {c.force} of {name} is {values[c.force]} at t = {float(t):.6g} ({part})"
+                return f"the friction force {c.force} of {name} is {values[c.force]} ({part})"
         for s_, e in spec.equations.items():
             text = why(f"equations[{s_!r}]", e)
             if text:

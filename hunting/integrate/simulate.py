@@ -215,6 +215,10 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
         if not fixed:
             h0 = float(finfo[K.F_H])
     status, message = make_status(int(info[K.I_STATUS]), float(finfo[K.F_T]))
+    if status == Status.NON_FINITE and system.explain is not None:
+        detail = system.explain(int(info[K.I_MODE]), float(finfo[K.F_T]), x_final, p)
+        if detail:
+            message = f"{message}; {detail}"
     if status == Status.INVALID_MODE:
         raise SystemDefinitionError(f"{system.name}: mode function or transition returned mode "
                                     f"{int(info[K.I_MODE])}, not one of 0..{system.n_modes - 1}")
@@ -267,11 +271,30 @@ def _start_problem(system: PiecewiseSystem, t0: float, x0: np.ndarray, m0: int, 
     if detail is None:
         parts = [f"d{n}/dt = {v}" for n, v in zip(system.state_names, f) if not np.isfinite(v)]
         parts += [f"guard '{n}' = {v}" for n, v in zip(system.guard_names or ("guard",), g) if not np.isfinite(v)]
-        zeros = [n for n, v in zip(system.param_names, p) if v == 0]
-        detail = ", ".join(parts) + (f" (parameters that are 0: {', '.join(zeros)})" if zeros else "")
+        zeros = _zero_parameters_to_blame(system, mode, t0, x0, p)
+        detail = ", ".join(parts) + (f" (finite with {', '.join(z + ' != 0' for z in zeros)})" if zeros else "")
     return (Status.NON_FINITE, mode,
             f"at t = {t0:.12g}: the vector field is not finite at the initial state (mode {system.modes[mode].name}): "
             f"{detail}; change the parameter values or the initial state")
+
+
+def _zero_parameters_to_blame(system: PiecewiseSystem, mode: int, t0: float, x0: np.ndarray, p: np.ndarray) -> list:
+    """The named parameters that are 0 and whose change to 1 alone makes the vector field and
+    guards finite at the initial state (a division by a zero mass, say)."""
+    out = []
+    f = np.empty(system.n_states)
+    g = np.empty(system.n_guards)
+    for j, name in enumerate(system.param_names):
+        if p[j] != 0:
+            continue
+        q = p.copy()
+        q[j] = 1.0
+        with np.errstate(all="ignore"):
+            system.vector_field(mode, t0, x0, q, f)
+            system.guards(mode, t0, x0, q, g)
+        if np.all(np.isfinite(f)) and np.all(np.isfinite(g)):
+            out.append(name)
+    return out
 
 
 def _ended_at_start(system, t0, x0, problem, method, throw) -> Trajectory:
