@@ -2,8 +2,6 @@
 with no denominator, an initial state beyond what double precision integrates, a stick bound
 that moves with the state or lies below the slip force. Each case used to end with advice about
 something else (STEP_TOO_SMALL "use radau", ZENO "declare a sliding mode") or to run."""
-import copy
-
 import numpy as np
 import pytest
 
@@ -11,22 +9,7 @@ import hunting
 from hunting.cli import main
 from hunting.errors import Status, SystemDefinitionError
 
-BELT = {"parameters": {"m": 1.0, "k": 2.0, "Fc": 0.3, "Fs": 0.5, "vs": 0.05, "vb": 0.1},
-        "states": ["q", "v"], "signals": {"u": "-k*q"},
-        "equations": {"q": "v", "v": "(u - F)/m"},
-        "friction": {"force": "F", "velocity": "v - vb", "model": "switch",
-                     "slip": "sign(w)*(Fc + (Fs - Fc)*exp(-abs(w)/vs))", "stick": "Fs"}}
-
-
-def belt(**changes):
-    d = copy.deepcopy(BELT)
-    for path, value in changes.items():
-        *keys, last = path.split("__")
-        tgt = d
-        for k in keys:
-            tgt = tgt[k]
-        tgt[last] = value
-    return d
+from test_describe import _with as belt    # the belt description with entries changed ("a__b": value)
 
 
 # ---------------------------------------------------------------- non-finite at the start
