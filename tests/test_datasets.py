@@ -139,6 +139,13 @@ def test_a_local_copy_that_differs_is_named_with_both_hashes(fake, isolated, mon
     assert (isolated / "d" / "DATA_EMPS_PULSES.mat").read_bytes() == b"changed"     # left as it is
 
 
+def test_hunting_data_without_the_files_is_said(fake, isolated, monkeypatch, caplog):
+    monkeypatch.setenv("HUNTING_DATA", str(isolated))
+    with pytest.raises(ds.DataError, match=r"\$HUNTING_DATA"):
+        ds.emps(download=False)
+    assert f"HUNTING_DATA={isolated} holds no DATA_EMPS.mat and DATA_EMPS_PULSES.mat" in caplog.text
+
+
 def test_nothing_local_and_no_download(fake):
     with pytest.raises(ds.DataError, match="HUNTING_DATA") as e:
         ds.emps(download=False)

@@ -225,6 +225,8 @@ def emps(url: str | None = None, download: bool = True) -> EmpsFiles:
     """
     files = EMPS_SHA256
     d = _local(files)
+    if d is None and os.environ.get(ENV_DATA):
+        log.warning("%s=%s holds no %s (nor its emps/ folder)", ENV_DATA, os.environ[ENV_DATA], " and ".join(files))
     if d is None:
         url = url or EMPS_URL
         looked = "; ".join(f"{label} ({p})" for label, p in search_dirs("emps"))
