@@ -79,14 +79,16 @@ class Dwell:
 
 def highpass_response(a: np.ndarray, dt: float, frequency: float, damping: float) -> np.ndarray:
     """H(s) a with H(s) = s^2 / (s^2 + 2 zeta w s + w^2), w = 2 pi frequency: causal, discretized
-    by the bilinear transform prewarped at w (exact gain and phase at the resonance)."""
-    from scipy.signal import bilinear, lfilter
+    by the bilinear transform s = K (1 - 1/z) / (1 + 1/z), K = 2 / dt, prewarped at w (exact gain and
+    phase at the resonance); a (n,) or (n, k) along axis 0."""
+    from scipy.signal import lfilter
     w = 2 * np.pi * frequency
-    fs = 1.0 / dt
-    # prewarping: design at the analog frequency that the bilinear map sends to w
-    wa = 2 * fs * np.tan(w / (2 * fs))
-    b, den = bilinear([1.0, 0.0, 0.0], [1.0, 2 * damping * wa, wa ** 2], fs)
-    return lfilter(b, den, np.asarray(a, dtype=float))
+    K = 2.0 / dt
+    wa = K * np.tan(w * dt / 2)          # the analog frequency the bilinear map sends to w
+    c = 2 * damping * wa * K
+    den = np.array([K * K + c + wa * wa, 2 * (wa * wa - K * K), K * K - c + wa * wa])
+    b = K * K * np.array([1.0, -2.0, 1.0])
+    return lfilter(b / den[0], den / den[0], np.asarray(a, dtype=float), axis=0)
 
 
 @dataclass(frozen=True)
@@ -329,10 +331,11 @@ def fit_coulomb_viscous(kin, *, v_min_frac: float = 0.02) -> tuple[NominalModel,
     """Symmetric Coulomb + viscous model without offset by least squares on the inverse dynamics
     (IDIM-LS): force = m a + H_a[Fc sign(v) + b v] on the samples with |v| > v_min_frac max|v|.
     kin : Kinematics. Returns (model, {"mass", "Fc", "b"} standard uncertainties)."""
-    sel = np.abs(kin.v) > v_min_frac * np.max(np.abs(kin.v))
-    Phi = np.column_stack([kin.a, kin.filtered(np.column_stack([np.sign(kin.v), kin.v]))])[sel]
-    theta, *_ = np.linalg.lstsq(Phi, kin.force[sel], rcond=None)
-    r = kin.force[sel] - Phi @ theta
+    sel = kin.moving & (np.abs(kin.v) > v_min_frac * np.max(np.abs(kin.v)))
+    Phi = np.column_stack([kin.a, kin.sliding(np.column_stack([np.sign(kin.vf), kin.vf]))])[sel]
+    y = kin.sliding(kin.drive)[sel]
+    theta, *_ = np.linalg.lstsq(Phi, y, rcond=None)
+    r = y - Phi @ theta
     s2 = float(r @ r) / max(sel.sum() - 3, 1)
     sd = np.sqrt(np.diag(np.linalg.inv(Phi.T @ Phi)) * s2)
     m, Fc, b = map(float, theta)

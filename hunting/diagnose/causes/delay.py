@@ -1,7 +1,12 @@
 """Actuation delay tau: the plant receives cm u(t - tau) ~ cm u(t) - tau cm u'(t), so the
 residual gains tau cm u'(t) (first order in tau, valid while tau << the signal's time scales)."""
+from ._words import _q
+
 NAME = "delay"
 DESCRIPTION = "actuation or measurement delay"
+FAMILY = "velocity"
+HYPERS = 0
+UNITS = {"delay": "s"}
 
 
 def hypers(kin, model) -> list:
@@ -9,7 +14,7 @@ def hypers(kin, model) -> list:
 
 
 def design(kin, model, hyper):
-    return (kin.cm * kin.du)[:, None]
+    return kin.du[:, None]
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -18,3 +23,9 @@ def parameters(theta, hyper, model) -> dict:
 
 def extend(model, theta, hyper):
     return model.replace(delay=max(model.delay + float(theta[0]), 0.0))
+
+
+def sentence(p, inc, model) -> str:
+    d = inc.get("delay", p["delay"])
+    return (f"the drive force acts {_q(abs(d), None, 's')} {'later' if d >= 0 else 'earlier'} than the model assumes "
+            f"(delay {_q(p['delay'], None, 's')})")

@@ -18,10 +18,13 @@ with 2 numerator degrees of freedom (gain and time). Gain: the RMS of e on the v
 rests, nominal (the model's break-away force) against extended."""
 import numpy as np
 from scipy import stats
+from ._words import _q
 
 NAME = "dwell"
 DESCRIPTION = "break-away force growing with the time at rest"
 CHANNEL = "own"
+FAMILY = "break-away"
+UNITS = {"level": "N", "gain": "N", "time": "s"}
 MIN_RESTS = 6
 
 
@@ -84,14 +87,14 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     from ..model import Dwell
     t, F, s = rests(fit, model, resolution)
     if t.size < MIN_RESTS:
-        return dict(reason=f"{t.size} rests ending in motion in the fitting data (need {MIN_RESTS})")
+        return dict(reason=f"{t.size} rests ending in motion in the fitting data (need {MIN_RESTS})", untestable=True)
     if np.ptp(t) < 0.5 * np.mean(t):
-        return dict(reason=f"the rests all last about {np.mean(t):.3g} s: a dwell effect cannot be told from Fs")
+        return dict(reason=f"the rests all last about {np.mean(t):.3g} s: a dwell effect cannot be told from Fs", untestable=True)
     e = excess(model, t, F, s)
     (ss, th, tau), ss0 = _fit(t, e)
     dof = t.size - 4
     if dof < 1:
-        return dict(reason="too few rests for the F test")
+        return dict(reason="too few rests for the F test", untestable=True)
     Fstat = ((ss0 - ss) / 2) / max(ss / dof, 1e-300)
     p = float(stats.f.sf(Fstat, 2, dof))
     out = dict(statistic=float(Fstat), p_value=p)
@@ -99,7 +102,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         return dict(out, reason=f"the break-away force falls with the rest (gain {th[1]:.3g} N): not a dwell effect")
     tv, Fv, sv = rests(validate, model, resolution)
     if tv.size < 3:
-        return dict(out, reason=f"{tv.size} rests ending in motion in the validation data (need 3)")
+        return dict(out, reason=f"{tv.size} rests ending in motion in the validation data (need 3)", untestable=True)
     base = model.dwell or Dwell(0.0, 0.0, tau)
     ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau))
     ev0, ev1 = excess(model, tv, Fv, sv), excess(ext, tv, Fv, sv)
@@ -115,3 +118,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
                 sigma={"level": float(np.sqrt(cov[0, 0])), "gain": float(np.sqrt(cov[1, 1])), "time": sig_tau},
                 metric="break-away force RMS error [N], validation rests",
                 nominal=float(np.sqrt(np.mean(ev0 ** 2))), extended=float(np.sqrt(np.mean(ev1 ** 2))), model=ext)
+
+
+def sentence(p, inc, model) -> str:
+    return (f"the break-away force grows with the time at rest by up to {_q(p['gain'], None, 'N')} "
+            f"(time constant {_q(p['time'], None, 's')}), which the model's constant static level lacks")

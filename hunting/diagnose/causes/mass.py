@@ -1,6 +1,11 @@
 """A wrong mass (or inertia)."""
+from ._words import _pct, _q
+
 NAME = "mass"
 DESCRIPTION = "mass (inertia)"
+FAMILY = "inertia"
+HYPERS = 0
+UNITS = {"mass": "kg"}
 
 
 def hypers(kin, model) -> list:
@@ -17,3 +22,9 @@ def parameters(theta, hyper, model) -> dict:
 
 def extend(model, theta, hyper):
     return model.replace(mass=model.mass + float(theta[0]))
+
+
+def sentence(p, inc, model) -> str:
+    rel = p["mass"] / model.mass - 1
+    return (f"the moving mass is {_pct(abs(rel))} {'larger' if rel > 0 else 'smaller'} than the model's "
+            f"({_q(p['mass'], None, 'kg')} instead of {_q(model.mass, None, 'kg')})")

@@ -12,15 +12,20 @@ import numpy as np
 NAME = "saturation"
 DESCRIPTION = "controller output saturation missing from the model"
 CHANNEL = "own"
+FAMILY = "actuator"
+UNITS = {"saturation": ""}
 MIN_RUN = 5
 
 
 def bound_runs(u: np.ndarray) -> tuple[float, int, float]:
     """(bound |u| [u units], the longest run at it [samples], the fraction of samples at it)."""
     from ..resimulate import resolution_of
-    best = (float(np.max(np.abs(u))), 0, 0.0)
+    peak = float(np.max(np.abs(u)))
+    best = (peak, 0, 0.0)
     for sgn in (1.0, -1.0):
         ext = float(np.max(sgn * u))
+        if not ext > 0.5 * peak:
+            continue                  # a bound is an extreme of |u| (u resting at 0 is not one)
         tol = max(1e-6 * abs(ext), 0.5 * resolution_of(u))
         at = sgn * u >= ext - tol
         edges = np.flatnonzero(np.diff(np.concatenate([[0], at.astype(np.int8), [0]])))
@@ -41,9 +46,14 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     if abs(sat - U) <= 0.01 * U:
         return dict(out, reason=f"the model already saturates at {sat:.4g}")
     if not can_sim:
-        return dict(out, reason="the gain needs re-simulation: the model's controller and the reference q_ref")
+        return dict(out, reason="the gain needs re-simulation: the model's controller and the reference q_ref", untestable=True)
     ext = model.replace(controller=dict(model.controller, saturation=U))
     return dict(out, parameters={"saturation": U}, sigma={"saturation": None},
                 metric="re-simulated position RMS error [m], validation", nominal=position_rms_error(validate, model),
                 extended=position_rms_error(validate, ext),
                 model=ext)
+
+
+def sentence(p, inc, model) -> str:
+    return (f"the controller output saturates at ±{p['saturation']:.4g} (in u's unit), which the model's controller "
+            "does not")

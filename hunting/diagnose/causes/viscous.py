@@ -2,9 +2,13 @@
 from dataclasses import replace
 
 from . import with_curves
+from ._words import _q
 
 NAME = "viscous"
 DESCRIPTION = "viscous coefficient b"
+FAMILY = "velocity"
+HYPERS = 0
+UNITS = {"b": "N s/m"}
 
 
 def hypers(kin, model) -> list:
@@ -12,7 +16,7 @@ def hypers(kin, model) -> list:
 
 
 def design(kin, model, hyper):
-    return kin.filtered(kin.v)[:, None]
+    return kin.sliding(kin.vf)[:, None]
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -21,3 +25,10 @@ def parameters(theta, hyper, model) -> dict:
 
 def extend(model, theta, hyper):
     return with_curves(model, lambda c: replace(c, b=c.b + float(theta[0])))
+
+
+def sentence(p, inc, model) -> str:
+    b0 = model.curve.positive.b
+    ratio = p["b"] / b0 if b0 else float("inf")
+    return (f"viscous friction is {ratio:.3g} times the model's (b = {_q(p['b'], None, 'N s/m')} instead of "
+            f"{_q(b0, None, 'N s/m')})")
