@@ -174,3 +174,45 @@ def lugre_equilibrium_eigenvalues(loop: ServoLoop, beta_frac: float, q: float) -
     S.servo_jac(S.V_POS, 0.0, x, p, Jp)
     S.servo_jac(S.V_NEG, 0.0, x, p, Jm)
     return np.linalg.eigvals((1.0 - q) * Jm + q * Jp)
+
+
+def _poly_text(poly) -> str:
+    """'s^3 + 1 s^2 - 5 s + 50' for [1, a2, a1, a0]."""
+    text = "s^3"
+    for a, power in zip(poly[1:], (" s^2", " s", "")):
+        text += f" {'-' if a < 0 else '+'} {abs(a):.4g}{power}"
+    return text
+
+
+def _growth_rate(poly) -> float:
+    """Largest real part of the roots of s^3 + a2 s^2 + a1 s + a0 [1/s]."""
+    return float(np.max(np.roots(np.asarray(poly, dtype=float)).real))
+
+
+def unstable_linear_parts(loop: ServoLoop) -> list[str]:
+    """Sentences naming each linear part of the loop that is unstable (empty when none is).
+
+    Two linear loops are checked: the loop without friction, m s^3 + cm kd s^2 + (cm kp +
+    alpha) s + cm ki, and the slip dynamics linearized at zero velocity (the equilibrium set's
+    linearization of :func:`stability_condition`, with viscous damping and, for beta = 1, the
+    Stribeck slope). An unstable part is allowed (it may be the study); a caller reports it up
+    front. Loops without a controller (kp = kd = ki = 0) have no linear loop to check."""
+    c, pl = loop.controller, loop.plant
+    if c.kp == c.kd == c.ki == 0:
+        return []
+    m, cm = pl.mass, pl.motor_constant
+    free = (1.0, cm * c.kd / m, (cm * c.kp + cogging_slope(loop)) / m, cm * c.ki / m)
+    out = []
+    tol = 1e-9 * max(1.0, max(abs(a) for a in free))
+    rate = _growth_rate(free)
+    if rate > tol:
+        out.append(f"the linear loop without friction is unstable: {_poly_text(free)} has a root with real part {rate:+.4g} 1/s (controller gains kp = {c.kp:.4g}, "
+                   f"kd = {c.kd:.4g}, ki = {c.ki:.4g})")
+    cond = stability_condition(loop)
+    if cond.polynomial is not None:
+        rate_slip = _growth_rate(cond.polynomial)
+        if rate_slip > tol:
+            out.append(f"the slip dynamics linearized at zero velocity are unstable ({cond.regime}): "
+                       f"{_poly_text(cond.polynomial)} has a root with real part {rate_slip:+.4g} 1/s, "
+                       "so the equilibrium set is not stable by the sufficient condition (thesis section 9.3)")
+    return out

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from . import simulate
+from ._atomic import write_text
 from .models import preset
 from .plotting import plot_hysteresis, plot_trajectory
 
@@ -68,7 +69,7 @@ def run_demo(out: Path) -> int:
     _check(rows, "displacement after one force cycle / max", float(abs(tr.x[-1, 0]) / xmax), 0.0, 1e-3)
     plot_hysteresis(force, tr.x[:, 0], title="Fig. 4.2: LuGre presliding (Table 4.1)", path=out / "fig4_2.png")
 
-    (out / "demo.json").write_text(json.dumps(rows, indent=2))
+    write_text(out / "demo.json", json.dumps(rows, indent=2))
     bad = [r["check"] for r in rows if not r["ok"]]
     print(f"figures and results in {out}/")
     if bad:

@@ -12,9 +12,19 @@ def _plt():
 
 
 def save(fig, path) -> None:
-    """Save a figure and release it (reproducers make dozens of figures)."""
-    fig.savefig(path, dpi=130)
-    _plt().close(fig)
+    """Save a figure (atomically: a temporary file, then a rename) and release it (reproducers
+    make dozens of figures)."""
+    from pathlib import Path
+
+    import matplotlib
+
+    from ._atomic import atomic_path
+    fmt = Path(path).suffix[1:].lower() or matplotlib.rcParams["savefig.format"]
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=130, format=fmt)
+    finally:
+        _plt().close(fig)
 
 
 def _axes(ax, figsize):

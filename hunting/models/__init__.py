@@ -4,8 +4,8 @@ from .friction import (Coulomb, DirectionalCurve, Discontinuous, LuGre, Stribeck
                        Viscous)
 from .loop import ServoLoop
 from .plant import Cogging, Plant
-from .presets import PRESETS, describe_presets, loop_from_parameters, preset
+from .presets import PRESETS, describe_presets, loop_from_parameters, preset, preset_description
 
 __all__ = ["PID", "Coulomb", "DirectionalCurve", "Discontinuous", "LuGre", "StribeckCurve", "Switch",
            "Viscous", "ServoLoop", "Cogging", "Plant", "PRESETS", "describe_presets",
-           "loop_from_parameters", "preset"]
+           "loop_from_parameters", "preset", "preset_description"]

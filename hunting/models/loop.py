@@ -70,6 +70,40 @@ class ServoLoop:
         units = {"x1": q, "x2": f"{q}/s", "x3": f"{q} s", "x4": q, "F": F}
         return S.build_servo_system(self.name, self.param_array(), odd=self.odd, units=units)
 
+    def description(self) -> dict:
+        """This loop as a model description (controller gains kp, kd, ki; the friction curve's
+        parameters; cogging harmonics): ``hunting.model(loop.description())`` compiles the same
+        loop from equations. Raises SystemDefinitionError for what has no expression form
+        (banded Switch, cogging tables, the triangle-wave force)."""
+        from .servo_description import servo_description
+        pl, c, fr = self.plant, self.controller, self.friction
+        v = {"m": pl.mass, "cm": pl.motor_constant, "q_d": pl.setpoint, "kp": c.kp, "kd": c.kd, "ki": c.ki}
+        if isinstance(fr, LuGre):
+            v.update(model="lugre", sigma0=fr.sigma0, sigma1=fr.sigma1, vd=fr.vd)
+        else:
+            v["model"] = "switch" if fr.variant == "filippov" else "switch-banded"
+        pos, neg = fr.curve.positive, fr.curve.negative
+        for sfx, cv in (("", pos), ("_neg", neg)) if pos != neg else (("", pos),):
+            v.update({k + sfx: getattr(cv, k) for k in ("Fc", "Fs", "vs", "beta", "b")})
+        fe = pl.external_force
+        if isinstance(fe, tuple):
+            v["force_amplitude"] = fe[1]
+        elif fe is not None:
+            v["f_ext"] = float(fe)
+        cog = pl.cogging
+        if cog is not None:
+            from .plant import COG_HARMONIC
+            if cog.kind != COG_HARMONIC:
+                raise SystemDefinitionError(f"{self.name}: a cogging table has no expression form; use harmonics")
+            v.update(cog_period=cog.period, cog_cos=cog.data[0::2], cog_sin=cog.data[1::2])
+        return servo_description(v, name=self.name)
+
+    def as_model(self):
+        """This loop compiled from its description (:meth:`description`): a
+        ``hunting.CompiledModel`` with named parameters (kp, kd, ki, Fc, ...)."""
+        from ..describe import model
+        return model(self.description())
+
     @property
     def n_states(self) -> int:
         return 4 if self.model_code == S.MODEL_LUGRE else 3

@@ -199,6 +199,17 @@ def preset(name: str, **overrides) -> ServoLoop:
     return loop_from_parameters(values, name=label, rotational=pr.rotational)
 
 
+def preset_description(name: str, **overrides) -> dict:
+    """The preset as a model description (``hunting.model(preset_description("table9.1"))``
+    compiles it like a user model; parameter names are the preset vocabulary). Raises
+    SystemDefinitionError for presets with no expression form (the banded Switch variant, the
+    triangle-wave force of table4.1)."""
+    from .servo_description import servo_description
+    values = resolve_parameters(name, overrides)
+    label = name if not overrides else name + "(" + ", ".join(f"{k}={v}" for k, v in overrides.items()) + ")"
+    return servo_description(values, name=label)
+
+
 def describe_presets() -> str:
     """Text listing of every preset with its parameters and units (for ``hunting models``)."""
     lines = []

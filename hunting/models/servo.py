@@ -30,16 +30,18 @@ from ..system import GUARD_SIG, JAC_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, Piec
 from .friction import lugre_partials, lugre_rates, slip_force, stribeck_level_slope
 from .plant import cogging_force, cogging_slope, external_force
 
-# ---- flat parameter layout
-M, CM, KP, KD, KI, QD, FEXT_KIND, FEXT_AMP, FEXT_PERIOD, MODEL = range(10)
-POS = 10          # Fc, Fs, vs, beta, b for v > 0
-NEG = 15          # the same for v < 0
-ETA, ALPHA, SIGMA0, SIGMA1, VD = 20, 21, 22, 23, 24
-COG = 25          # kind, n, period, data...
+# ---- flat parameter layout: the names are the one source, the slots below are read from them
 PARAM_NAMES = ("m", "cm", "kp", "kd", "ki", "q_d", "fext_kind", "fext_amp", "fext_period", "model",
                "Fc_pos", "Fs_pos", "vs_pos", "beta_pos", "b_pos",
                "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg",
                "eta", "alpha", "sigma0", "sigma1", "vd", "cog_kind", "cog_n", "cog_period")
+_SLOT = {name: i for i, name in enumerate(PARAM_NAMES)}
+M, CM, KP, KD, KI, QD = (_SLOT[k] for k in ("m", "cm", "kp", "kd", "ki", "q_d"))
+FEXT_KIND, FEXT_AMP, FEXT_PERIOD, MODEL = (_SLOT[k] for k in ("fext_kind", "fext_amp", "fext_period", "model"))
+POS = _SLOT["Fc_pos"]      # Fc, Fs, vs, beta, b for v > 0
+NEG = _SLOT["Fc_neg"]      # the same for v < 0
+ETA, ALPHA, SIGMA0, SIGMA1, VD = (_SLOT[k] for k in ("eta", "alpha", "sigma0", "sigma1", "vd"))
+COG = _SLOT["cog_kind"]    # kind, n, period, data... (the cogging block runs to the end of the array)
 
 MODEL_SWITCH, MODEL_BANDED, MODEL_LUGRE = 0, 1, 2
 SLIP_POS, SLIP_NEG, STICK = 0, 1, 2               # switch

@@ -6,6 +6,8 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .._atomic import write_text
+
 
 @dataclass
 class Ledger:
@@ -29,7 +31,7 @@ class Ledger:
         return [r["check"] for r in self.rows if not r["ok"]]
 
     def save(self, path: Path, extra: dict | None = None) -> None:
-        path.write_text(json.dumps(dict(title=self.title, checks=self.rows, **(extra or {})), indent=2,
+        write_text(path, json.dumps(dict(title=self.title, checks=self.rows, **(extra or {})), indent=2,
                                    default=float))
 
     def finish(self, out: Path) -> int:

@@ -1,0 +1,29 @@
+"""``hunting reproduce``: a thesis chapter's tables and figures, checked against the thesis."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .boundary import Output
+
+NAME = "reproduce"
+HELP = "reproduce a thesis chapter (tables, figures, checks)"
+CHAPTERS = ("ch8", "ch9", "ch10")
+
+
+def add_arguments(p) -> None:
+    p.add_argument("chapter", choices=CHAPTERS, help="the chapter: " + ", ".join(CHAPTERS))
+    p.add_argument("--out", metavar="DIR", help="directory for figures and JSON (default out/CHAPTER)")
+
+
+def _out(args) -> str:
+    return args.out or f"out/{args.chapter}"
+
+
+def files(args):
+    return [Output("--out", _out(args), "dir")], []
+
+
+def run(args, results) -> int:
+    import importlib
+    mod = importlib.import_module(f"hunting.reproduce.{args.chapter}")
+    return mod.run(Path(_out(args)))
