@@ -60,8 +60,8 @@ class Measurement:
         dt = np.diff(self.t)
         if np.any(dt <= 0):
             k = int(np.flatnonzero(dt <= 0)[0])
-            raise SystemDefinitionError(f"{self.name}: t must increase: sample {k + 1} has t = {self.t[k + 1]!r} s "
-                                        f"after t = {self.t[k]!r} s (sort the rows or remove repeated times)")
+            raise SystemDefinitionError(f"{self.name}: t must increase: sample {k + 1} has t = {float(self.t[k + 1]):.6g} s "
+                                        f"after t = {float(self.t[k]):.6g} s (sort the rows or remove repeated times)")
         if np.ptp(dt) > 1e-3 * np.mean(dt):
             k = int(np.argmax(np.abs(dt - np.median(dt))))
             raise SystemDefinitionError(f"{self.name}: t must be uniformly sampled: steps range from {dt.min():.6g} "

@@ -328,6 +328,16 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
     parameters' sensitivity columns appended (their covariance is the delta method's)."""
     idx, run, noise = lib.Sf.idx, lib.Sf.run, lib.noise
     members = list(ex.members)
+    bounds = {}
+    for name, _ in members:
+        mod = CAUSES[name]
+        b = getattr(mod, "hyper_bounds", None)
+        b = b(lib.kf, lib.model) if b else {}
+        for key in getattr(mod, "HYPER_KEYS", ()):
+            if key not in b:        # the range of the variants searched, 3 % wider
+                vals = [v.hyper[key] for v in lib.variants[name]]
+                b[key] = (min(vals) / 1.03, max(vals) * 1.03)
+        bounds[name] = b
     keys = [(name, k) for name, _ in members for k in getattr(CAUSES[name], "HYPER_KEYS", ())]
 
     def design(mem):
@@ -369,7 +379,8 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
             v = lib.variants[name][j]
             h = dict(v.hyper)
             for key in getattr(CAUSES[name], "HYPER_KEYS", ()):
-                h[key] = float(v.hyper[key] * np.exp(step[i]))
+                lo, hi = bounds[name][key]
+                h[key] = float(np.clip(v.hyper[key] * np.exp(step[i]), lo, hi))
                 i += 1
             if h != v.hyper:
                 lib.variants[name].append(lib.variant(name, h))

@@ -39,7 +39,7 @@ class Kinematics:
     (H_a of the instantaneous acceleration on sliding samples), force [N] (H_a of the drive force
     cm u + f_ext), du [N/s] (H_a of the drive force's rate on sliding samples); cm : motor
     constant; window [s]; moving : samples used for the force balance (|v| above v_min, away from
-    the filter edges and from stops and break-aways by half a window); vf [m/s] : short-window velocity for the friction maps; a_inst [m/s^2] :
+    the filter edges); vf [m/s] : short-window velocity for the friction maps; a_inst [m/s^2] :
     second differences of q; drive [N] : cm u (aligned for the zero-order hold) + f_ext; slide :
     bool, the mass slides (not stuck); resolution, noise [m] : the position sensor's step and
     noise (standard deviation before quantization)."""
@@ -142,11 +142,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     moving = np.abs(v) > v_min_frac * np.max(np.abs(v))
     edge = np.zeros(meas.n, bool)
     edge[w:-w] = True                    # drop the filter's edge samples
-    # a stop or a break-away inside the window: the friction map at a smoothed velocity is least
-    # certain there (the force jumps within a few samples), so those samples are not used
-    change = np.zeros(meas.n, bool)
-    change[1:] = slide[1:] != slide[:-1]
-    moving &= edge & ~dilate(change, w // 2)
+    moving &= edge
     return Kinematics(meas.t, q, v, a, force, du, float(cm), w * dt, moving, vf, a_inst, drive, slide,
                       float(resolution), float(noise))
 

@@ -29,6 +29,34 @@ from ..errors import SystemDefinitionError, check_finite, check_finite_positive
 from ..models.friction import DirectionalCurve, LuGre, StribeckCurve
 from ..models.plant import COG_TABLE, Cogging
 
+SCHEMA_HELP = """\
+MODEL.json: the nominal model, a JSON object with the keys below (SI units; unknown keys are
+errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(q') - offset - F_cog(q).
+
+  "plant":      "mass" [kg] (required; the total moving mass), "motor_constant" cm [N per unit
+                of u] (default 1), "offset" [N], "delay" [s],
+                "cogging": [{"pitch": m, "cos": [N, ..], "sin": [N, ..]}]  (harmonics 1, 2, ..),
+                "flexibility": {"load_mass": kg, "frequency": Hz, "damping": ratio}
+  "friction":   "law": "coulomb-viscous" | "stribeck" | "switch" | "lugre";
+                "Fc" [N] (required), "Fs" [N], "vs" [m/s], "beta", "b" [N s/m];
+                "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg" for the negative direction;
+                "sigma0" [N/m], "sigma1" [N s/m] (lugre); "lag" [s];
+                "dwell": {"level": N, "gain": N, "time": s}
+  "controller": {"type": "pid", "kp", "kd", "ki"} (or "form": "PDI" with "P", "D", "I", or
+                "form": "K" with "K"), optional "derivative_on": "error" | "measurement",
+                "tau_f" [s], "sample_time" [s], "saturation", "output_resolution";
+                or {"type": "pd-velocity-loop", "kp" [1/s], "kv", "sample_time", "saturation"}
+                (u = kv (kp (q_ref - q) - v)). Needed for the behaviour view and for the
+                saturation, quantization and presliding causes.
+  "sensor":     {"resolution": m, "noise": m}  (encoder step; noise before quantization)
+  or a preset:  {"preset": "table9.1", "set": {"P": 60.0}}  (see: hunting models)
+
+Example (examples/emps/model.json, the EMPS benchmark's published model):
+  {"plant": {"mass": 95.1089, "motor_constant": 35.15065188},
+   "friction": {"law": "coulomb-viscous", "Fc": 20.3935, "b": 203.5034},
+   "controller": {"type": "pd-velocity-loop", "kp": 160.18, "kv": 243.45,
+                  "sample_time": 0.001, "saturation": 10.0}}
+"""
 LAWS = ("coulomb-viscous", "stribeck", "switch", "lugre")
 _FRICTION_KEYS = {"law", "Fc", "Fs", "vs", "beta", "b", "sigma0", "sigma1", "sigma2",
                   "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg", "lag", "dwell"}

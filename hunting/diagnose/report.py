@@ -259,7 +259,7 @@ def write_report(dg: Diagnosis, directory) -> Path:
 <h1>Diagnosis</h1>
 <table border="1" cellpadding="4"><tr><th>validation metric</th><th>measured</th><th>nominal</th><th>extended</th></tr>{gains}</table>
 {'<ul>' + notes + '</ul>' if notes else ''}
-<p>Criterion: {html.escape(dg.criterion)}.</p>
+<p>Rule: {html.escape(dg.criterion)}.</p>
 <table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
 <th>validation metric: nominal → extended</th></tr>{rows}</table>
 {'<ul>' + finds + '</ul>' if finds else '<p>No cause found: the nominal model explains the data within the rule.</p>'}

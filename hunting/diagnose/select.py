@@ -174,6 +174,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if not (isinstance(max_causes, (int, np.integer)) and 1 <= max_causes <= 4):
         raise SystemDefinitionError(f"max_causes = {max_causes!r} must be an integer in [1, 4]")
     if validate is None:
+        if fit.n < 250:
+            raise SystemDefinitionError(f"{fit.name}: {fit.n} samples are too few to split into fitting and validation "
+                                        "parts (need >= 250, or give validation data)")
         t_split = fit.t[0] + 0.6 * (fit.t[-1] - fit.t[0])
         fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
     notes: list = list(check_inputs(fit, validate, model))
@@ -187,11 +190,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
     nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
-    # sliding samples: |v| above 2 % of the maximum, above the model's stick speed (creep in
-    # presliding is not sliding), and where the friction map's own uncertainty cannot dominate the
-    # residual (a steep Stribeck dip crossed within a few samples)
-    kf, kv = (replace(k, moving=k.moving & (np.abs(k.v) > model.v_stick()) & ~map_uncertain(k, model))
-              for k in (kf, kv))
+    kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
     untested: list = []
     tick("force channel")
     if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100:
@@ -255,6 +254,14 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
                      fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
                      fc["explanations"])
+
+
+def used_samples(kin: Kinematics, model: NominalModel) -> np.ndarray:
+    """bool (n,): the samples the force channel judges: sliding samples with |v| above 2 % of
+    the maximum and above the model's stick speed (creep in presliding is not sliding), where the
+    friction map's own uncertainty cannot dominate the residual (:func:`map_uncertain`: a steep
+    Stribeck dip crossed within a few samples)."""
+    return kin.moving & (np.abs(kin.v) > model.v_stick()) & ~map_uncertain(kin, model)
 
 
 class _Progress:

@@ -86,6 +86,11 @@ def band(kin) -> tuple[float, float]:
     return 2.0, hi
 
 
+def hyper_bounds(kin, model) -> dict:
+    """The refinement's range: the band a resonance can be seen in, damping ratios DAMPING_MAX."""
+    return {"frequency": band(kin), "damping": DAMPING_MAX}
+
+
 def untestable(kin, model) -> str | None:
     if (kin.moving & np.isfinite(kin.a)).sum() < 512:
         return "fewer than 512 sliding samples"
