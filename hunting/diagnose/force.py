@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SystemDefinitionError
 from .causes import CAUSES
 from .kinematics import Kinematics, residual
 from .model import NominalModel
@@ -37,7 +36,8 @@ from .stats import NoiseModel, Samples, gls, out_of_sample
 @dataclass
 class Variant:
     """One hyper-parameter variant of a cause: its regressors on the fitting and validation
-    records (n, k) and the known, unfitted force change (n,) (zeros without one)."""
+    records (n, k) and the known, unfitted force change (n,) (zeros without one); Xr, sr : the
+    same on the validation record's reference trajectory (None without one)."""
 
     name: str
     hyper: dict
@@ -45,6 +45,8 @@ class Variant:
     Xv: np.ndarray
     sf: np.ndarray
     sv: np.ndarray
+    Xr: np.ndarray | None = None
+    sr: np.ndarray | None = None
 
 
 @dataclass
@@ -72,9 +74,10 @@ class Library:
     """Every testable force-channel cause with its variants, and the whitened Gram matrix of
     all their regressors on the thinned fitting data."""
 
-    def __init__(self, names, kf: Kinematics, kv: Kinematics, model: NominalModel, used_f, used_v, step: int):
+    def __init__(self, names, kf: Kinematics, kv: Kinematics, model: NominalModel, used_f, used_v, step: int,
+                 kr: Kinematics | None = None):
         self.model = model
-        self.kf, self.kv = kf, kv
+        self.kf, self.kv, self.kr = kf, kv, kr
         self.untested: dict = {}
         self.variants: dict = {}
         self.rf = residual(kf, model)
@@ -99,10 +102,14 @@ class Library:
         """A cause's regressors and shifts at one hyper-parameter variant on both records."""
         mod = CAUSES[name]
         shift = getattr(mod, "shift", None)
-        kf, kv, model = self.kf, self.kv, self.model
-        return Variant(name, hyper, mod.design(kf, model, hyper), mod.design(kv, model, hyper),
-                       shift(kf, model, hyper) if shift else np.zeros(kf.t.size),
-                       shift(kv, model, hyper) if shift else np.zeros(kv.t.size))
+        kf, kv, kr, model = self.kf, self.kv, self.kr, self.model
+        v = Variant(name, hyper, mod.design(kf, model, hyper), mod.design(kv, model, hyper),
+                    shift(kf, model, hyper) if shift else np.zeros(kf.t.size),
+                    shift(kv, model, hyper) if shift else np.zeros(kv.t.size))
+        if kr is not None:
+            v.Xr = mod.design(kr, model, hyper)
+            v.sr = shift(kr, model, hyper) if shift else np.zeros(kr.t.size)
+        return v
 
     # --- the thinned, whitened design of every variant -------------------------------------
     def _index(self):
@@ -198,14 +205,15 @@ class Library:
 
     # --- predictions ------------------------------------------------------------------------
     def prediction(self, ex: Explanation, which: str) -> np.ndarray:
-        """The explanation's force change (n,) on the fitting ("f") or validation ("v") record."""
+        """The explanation's force change (n,) on the fitting ("f") or validation ("v") record, or
+        along the validation record's reference trajectory ("r")."""
         n = (self.rf if which == "f" else self.rv).size
         out = np.zeros(n)
         k = 0
         for name, j in ex.members:
             v = self.variants[name][j]
-            X = v.Xf if which == "f" else v.Xv
-            out += X @ ex.theta[k:k + X.shape[1]] + (v.sf if which == "f" else v.sv)
+            X, s = {"f": (v.Xf, v.sf), "v": (v.Xv, v.sv), "r": (v.Xr, v.sr)}[which]
+            out += X @ ex.theta[k:k + X.shape[1]] + s
             k += X.shape[1]
         return out
 
@@ -218,21 +226,21 @@ def _rms(x) -> float:
     return float(np.sqrt(np.mean(np.asarray(x) ** 2)))
 
 
-def select(lib: Library, max_causes: int, alpha: float, min_gain: float) -> dict:
+def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_reference: float = 0.01) -> dict:
     """The force channel's explanation (module docstring): {"explanation", "tests" (per member:
     gamma, t, p, gain, rms without), "rejected" (rows), "ranking" (every set searched, best
     first: (bic, names)), "noise_val"}."""
     names = list(lib.variants)
     sets = [()]
     for k in range(1, min(max_causes, len(names)) + 1):
-        sets += list(itertools.combinations(names, k))
+        sets += [s for s in itertools.combinations(names, k) if compatible(s)]
     fits = {s: lib.best_variants(s) for s in sets}
     ranking = sorted((e for e in fits.values() if e.physical), key=lambda e: e.bic)
     rejected = [dict(name=n, step="search", statistic=None, p_value=None, validation_gain=None,
                      reason=f"the fitted extension is not physical: {fits[(n,)].unphysical[n]}")
                 for n in names if not fits[(n,)].physical]
     # the validation noise model: the whole library's validation residual, fitted coefficients
-    full = fits.get(tuple(names)) or lib.best_variants(tuple(names))
+    full = lib.best_variants(tuple(names))
     Sv = lib.Sv
     e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
     noise_v = NoiseModel.fit(e_full, Sv.run)
@@ -252,12 +260,19 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float) -> dict
             rms_wo = lib.validation_rms(without)
             tests[name] = dict(gamma=gamma, t=t, p_value=p, gain=rms_wo / max(rms_full, 1e-300) - 1,
                                rms_without=rms_wo, rms=rms_full, bic_without=without.bic)
-        failing = [n for n in current.names if tests[n]["p_value"] >= alpha or tests[n]["gain"] < min_gain]
+            if lib.kr is not None and getattr(CAUSES[name], "NOISE_FED", False):
+                # the same prediction along the reference trajectory: free of the sensor's and the
+                # actuator's noise, which feedback puts into the measured regressors (a delay or
+                # mass "explaining" the loop's reaction to its own noise explains nothing here)
+                yr = (lib.prediction(current, "r") - lib.prediction(without, "r"))[Sv.idx]
+                tests[name]["p_reference"] = out_of_sample(e0, yr, Sv.run, noise_v)[2]
+        failing = [n for n in current.names if tests[n]["p_value"] >= alpha or tests[n]["gain"] < min_gain
+                   or tests[n].get("p_reference", 0.0) >= alpha_reference]
         if failing:
             worst = min(failing, key=lambda n: tests[n]["gain"])
             rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
                                  p_value=tests[worst]["p_value"], validation_gain=tests[worst]["gain"],
-                                 reason=_why(tests[worst], alpha, min_gain)))
+                                 reason=_why(tests[worst], alpha, min_gain, alpha_reference)))
             current = _physical_subset(lib, fits, tuple(n for n in current.names if n != worst), rejected)
             continue
         # the whole set must also beat every smaller set of its causes by min_gain (two causes
@@ -297,6 +312,12 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float) -> dict
                 ranking=ranking, noise_val=noise_v, fits=fits)
 
 
+def compatible(names) -> bool:
+    """No cause of the set excludes another (``EXCLUDES``: a special case of it, or a model that
+    cannot hold both)."""
+    return not any(o in names for n in names for o in getattr(CAUSES[n], "EXCLUDES", ()))
+
+
 def _physical_subset(lib: Library, fits: dict, names: tuple, rejected: list) -> Explanation:
     """The explanation with the causes ``names``, without those whose fitted extension is not
     physical in it (removed one at a time, each with a rejected row)."""
@@ -311,10 +332,13 @@ def _physical_subset(lib: Library, fits: dict, names: tuple, rejected: list) -> 
         names = tuple(n for n in names if n != name)
 
 
-def _why(t: dict, alpha: float, min_gain: float) -> str:
+def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) -> str:
     out = []
     if t["p_value"] >= alpha:
         out.append(f"not significant out of sample (p = {t['p_value']:.2g} >= {alpha:g})")
+    if t.get("p_reference", 0.0) >= alpha_reference:
+        out.append(f"its prediction along the reference trajectory does not explain the validation data "
+                   f"(p = {t['p_reference']:.2g} >= {alpha_reference:g}): the loop's reaction to its own noise")
     if t["gain"] < min_gain:
         out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
     return " and ".join(out)
@@ -415,13 +439,7 @@ def _unphysical(lib: Library, members, theta) -> dict:
     for name, j in members:
         v = lib.variants[name][j]
         kk = v.Xf.shape[1]
-        th = theta[k:k + kk]
-        w = getattr(CAUSES[name], "unphysical", lambda *a: None)(th, v.hyper, lib.model)
-        if not w:
-            try:
-                CAUSES[name].extend(lib.model, th, v.hyper)
-            except SystemDefinitionError as exc:     # e.g. a negative mass
-                w = str(exc)
+        w = getattr(CAUSES[name], "unphysical", lambda *a: None)(theta[k:k + kk], v.hyper, lib.model)
         if w:
             why[name] = w
         k += kk

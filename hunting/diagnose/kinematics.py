@@ -24,7 +24,7 @@ The residual of a model is r = H_a[g], g = drive - delay cm u' - m a - offset - 
 the acceleration is zero)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -39,7 +39,7 @@ class Kinematics:
     (H_a of the instantaneous acceleration on sliding samples), force [N] (H_a of the drive force
     cm u + f_ext), du [N/s] (H_a of the drive force's rate on sliding samples); cm : motor
     constant; window [s]; moving : samples used for the force balance (|v| above v_min, away from
-    the filter edges); vf [m/s] : short-window velocity for the friction maps; a_inst [m/s^2] :
+    the filter edges and from stops and break-aways by half a window); vf [m/s] : short-window velocity for the friction maps; a_inst [m/s^2] :
     second differences of q; drive [N] : cm u (aligned for the zero-order hold) + f_ext; slide :
     bool, the mass slides (not stuck); resolution, noise [m] : the position sensor's step and
     noise (standard deviation before quantization)."""
@@ -142,9 +142,33 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     moving = np.abs(v) > v_min_frac * np.max(np.abs(v))
     edge = np.zeros(meas.n, bool)
     edge[w:-w] = True                    # drop the filter's edge samples
-    moving &= edge
+    # a stop or a break-away inside the window: the stick classification and the friction map at
+    # a smoothed velocity are least certain there (the force jumps within a few samples)
+    change = np.zeros(meas.n, bool)
+    change[1:] = slide[1:] != slide[:-1]
+    moving &= edge & ~dilate(change, w // 2)
     return Kinematics(meas.t, q, v, a, force, du, float(cm), w * dt, moving, vf, a_inst, drive, slide,
                       float(resolution), float(noise))
+
+
+def reference_kinematics(meas: Measurement, model, *, window: float | None = None) -> Kinematics | None:
+    """Kinematics of an instrument trajectory, free of the sensor's and the actuator's noise: the
+    nominal closed loop re-simulated from the measured reference without sensor noise or
+    quantization (when the model has a controller; it follows the machine's tracking lag and
+    overshoot), else the reference itself with the model's inverse dynamics there as the drive
+    (m a_ref + F(v_ref) + offset + F_cog(q_ref)). None without a reference that moves."""
+    if meas.q_ref is None or np.ptp(meas.q_ref) <= 0:
+        return None
+    if model.controller is not None:
+        from .resimulate import resimulate
+        sim = resimulate(meas, model, resolution=0.0, sensor_noise=0.0)
+        if sim.ok:
+            return kinematics(Measurement(meas.t, sim.q, sim.u, name=meas.name + " (nominal loop)"), model.cm,
+                              window=window, resolution=0.0)
+    still = Measurement(meas.t, meas.q_ref, np.zeros(meas.n), name=meas.name + " (reference)")
+    k0 = kinematics(still, model.cm, window=window, resolution=0.0)
+    drive = model.mass * k0.a_inst + model.friction(k0.vf) + model.offset + model.cogging_force(meas.q_ref)
+    return kinematics(replace(still, u=drive / model.cm), model.cm, window=window, resolution=0.0)
 
 
 def acceleration_noise_psd(kin: Kinematics, f: np.ndarray) -> np.ndarray:

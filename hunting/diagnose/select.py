@@ -7,9 +7,12 @@ The rule (stated in every report, :data:`RULE`):
   fitting data's force residual, thinned and prewhitened by an AR noise model fitted on the
   residual of every candidate at once; a cause of the best explanation is kept when it explains
   the validation residual of the others out of sample (one-sided test, prewhitened, with an
-  autocorrelation- and level-consistent standard error: p < alpha) and dropping it grows the
-  validation RMS by at least ``min_gain``; the others are removed one by one and the rest
-  refitted (:mod:`hunting.diagnose.force`, :mod:`hunting.diagnose.stats`);
+  autocorrelation- and level-consistent standard error: p < alpha; when the reference moves,
+  also its prediction along the reference trajectory, p < alpha_reference: feedback puts the
+  sensor's and the actuator's noise into the measured regressors, not into the reference's),
+  dropping it grows the validation RMS by at least ``min_gain``, and the whole set beats each of
+  its subsets by as much; what fails is removed and the rest refitted
+  (:mod:`hunting.diagnose.force`, :mod:`hunting.diagnose.stats`);
 - causes with their own evidence (``CHANNEL = "own"``: dwell, saturation, quantization) bring a
   statistic with its p-value and a validation metric of their own (module docstrings); the same
   alpha and min_gain decide;
@@ -38,15 +41,16 @@ import numpy as np
 from ..errors import SystemDefinitionError
 from .causes import CAUSES
 from .data import Measurement
-from .kinematics import Kinematics, kinematics, map_uncertain
+from .kinematics import Kinematics, kinematics, map_uncertain, reference_kinematics
 from .model import NominalModel
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
         "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once; each "
         "of its causes kept when it explains the validation residual of the others out of sample (one-sided test, "
-        "prewhitened, autocorrelation-consistent standard error, p < {alpha:g}) and dropping it grows the validation "
-        "RMS by at least {min_gain:.0%}; other channels: their own statistic at p < {alpha:g} and a validation gain of "
-        "at least {min_gain:.0%}")
+        "prewhitened, autocorrelation-consistent standard error, p < {alpha:g}; with a moving reference its prediction "
+        "along the reference too, p < {alpha_reference:g}), dropping it grows the validation RMS by at least "
+        "{min_gain:.0%}, and the set beats each of its subsets by as much; other channels: their own statistic at "
+        "p < {alpha:g} and a validation gain of at least {min_gain:.0%}")
 CRITERION = RULE
 
 
@@ -154,14 +158,15 @@ class Diagnosis:
 
 
 def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
-             max_causes: int = 3, min_gain: float = 0.02, alpha: float = 1e-3, window: float | None = None,
-             behaviour: bool = True, progress=None) -> Diagnosis:
+             max_causes: int = 3, min_gain: float = 0.02, alpha: float = 1e-3, alpha_reference: float = 0.01,
+             window: float | None = None, behaviour: bool = True, progress=None) -> Diagnosis:
     """Rank the causes of the mismatch between the model and the measured data.
 
     fit : data to fit extensions on; validate : data to judge them on (default: the last 40 % of
     ``fit``, the first 60 % being used for fitting); causes : names to consider (default all);
-    max_causes : the largest set of force-channel causes searched; min_gain, alpha : the rule
-    (module docstring); behaviour : re-simulate the validation run (needs a controller and
+    max_causes : the largest set of force-channel causes searched; min_gain, alpha,
+    alpha_reference : the rule (module docstring); window [s] : the smoothing window (default
+    :func:`default_window`); behaviour : re-simulate the validation run (needs a controller and
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .force import Library, select
@@ -180,12 +185,14 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         t_split = fit.t[0] + 0.6 * (fit.t[-1] - fit.t[0])
         fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
     notes: list = list(check_inputs(fit, validate, model))
+    if window is None:
+        window = default_window(fit, validate, model)
     sensor = dict(resolution=model.resolution, noise=model.sensor_noise)
     kf = kinematics(fit, model.cm, window=window, **sensor)
     kv = kinematics(validate, model.cm, window=window, **sensor)
     check_units(kf, model, fit.name)
     check_units(kv, model, validate.name)
-    crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes)
+    crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
@@ -195,9 +202,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     tick("force channel")
     if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100:
         step = max(1, int(round(kf.window / fit.dt)) // 3)
-        lib = Library(force_names, kf, kv, model, kf.moving, kv.moving, step)
+        kr = reference_kinematics(validate, model, window=window)
+        lib = Library(force_names, kf, kv, model, kf.moving, kv.moving, step, kr)
         untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
-        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain))
+        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference))
     else:
         if force_names:
             why = ("fewer than 100 sliding samples (|v| > 2 % of the maximum, half a filter window from stops and "
@@ -217,6 +225,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             continue
         if model.law == "lugre":
             untested.append(dict(name=name, reason="the nominal model has LuGre bristles already"))
+            continue
+        if ext.lag > 0:
+            untested.append(dict(name=name, reason="the force channel found frictional memory (lag), which LuGre "
+                                                   "bristles would replace"))
             continue
         cause, row, ext = _stick_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim)
         if cause is not None:
@@ -254,6 +266,21 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
                      fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
                      fc["explanations"])
+
+
+WINDOW_CYCLES = 0.5      # the smoothing window, in periods of the loop's bandwidth (at least 31 samples)
+
+
+def default_window(fit: Measurement, validate: Measurement, model: NominalModel) -> float:
+    """The smoothing window [s]: 31 samples, or half a period of the loop's bandwidth when that is
+    longer (fast sampling: the acceleration's noise falls as the fifth power of the window, and
+    with it what feedback of that noise puts into the regressors), at most a quarter of the
+    shorter record."""
+    from .guards import loop_bandwidth
+    dt = fit.dt
+    f_bw = loop_bandwidth(model)
+    w = 31 * dt if not f_bw else max(31 * dt, WINDOW_CYCLES / f_bw)
+    return min(w, dt * (min(fit.n, validate.n) // 4))
 
 
 def used_samples(kin: Kinematics, model: NominalModel) -> np.ndarray:
@@ -322,7 +349,7 @@ def _members_parameters(lib, ex, cov=None) -> list:
 
 def _force_channel(lib, model, sel) -> dict:
     """Causes, extended model, residuals and alternatives from the force channel's selection."""
-    from .force import refine
+    from .force import compatible, refine
     ex = sel["explanation"]
     mf, mv = lib.used_f, lib.used_v
     cov, hyper_sigma = None, {}
@@ -352,6 +379,8 @@ def _force_channel(lib, model, sel) -> dict:
             if mate in seen or CAUSES[mate].FAMILY != c.family:
                 continue
             alt_set = tuple(sorted((chosen - {c.name}) | {mate}, key=list(lib.variants).index))
+            if not compatible(alt_set):
+                continue
             alt = fits.get(alt_set) or lib.best_variants(alt_set)
             if not alt.physical:
                 continue

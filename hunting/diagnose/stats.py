@@ -90,7 +90,8 @@ def local_scale(e: np.ndarray, run: np.ndarray, half: int = SCALE_HALF) -> np.nd
         j = np.arange(b - a)
         lo, hi = np.maximum(j - half, 0), np.minimum(j + half + 1, b - a)
         out[a:b] = np.sqrt((c[hi] - c[lo]) / (hi - lo))
-    return np.maximum(out, 1e-300)
+    # a stretch of exact zeros (a residual with nothing left in it) must not blow up e / s
+    return np.maximum(out, 1e-6 * float(np.sqrt(np.mean(e ** 2))) + 1e-300)
 
 
 @dataclass(frozen=True)

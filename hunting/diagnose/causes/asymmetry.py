@@ -12,6 +12,8 @@ NAME = "asymmetry"
 DESCRIPTION = "direction-dependent viscous friction (b+ != b-)"
 FAMILY = "velocity"
 HYPERS = 0
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+EXCLUDES = ("viscous",)      # v = max(v, 0) + min(v, 0): viscous is the special case b+ = b-
 UNITS = {"b_pos": "N s/m", "b_neg": "N s/m"}
 
 
@@ -28,6 +30,11 @@ def untestable(kin, model) -> str | None:
 
 def design(kin, model, hyper):
     return kin.sliding(np.column_stack([np.maximum(kin.vf, 0.0), np.minimum(kin.vf, 0.0)]))
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    bp, bn = model.curve.positive.b + float(theta[0]), model.curve.negative.b + float(theta[1])
+    return f"b+ = {bp:.3g}, b- = {bn:.3g} N s/m: a negative viscous coefficient" if min(bp, bn) < 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:

@@ -33,7 +33,7 @@ def hypers(kin, model) -> list:
     # the spectrum of the residual averaged in position bins of a tenth of the shortest
     # wavelength: what is periodic in q survives the averaging, the cost falls from the samples
     # (tens of thousands, visited again and again) to the bins
-    width = lo / 10
+    width = max(lo / 10, stroke / 2000)                     # at most ~2000 bins
     idx = np.floor((q - q.min()) / width).astype(np.int64)
     counts = np.bincount(idx)
     full = counts > 0

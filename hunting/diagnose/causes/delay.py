@@ -6,6 +6,7 @@ NAME = "delay"
 DESCRIPTION = "actuation or measurement delay"
 FAMILY = "velocity"
 HYPERS = 0
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 UNITS = {"delay": "s"}
 
 
@@ -15,6 +16,11 @@ def hypers(kin, model) -> list:
 
 def design(kin, model, hyper):
     return kin.du[:, None]
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    d = model.delay + float(theta[0])
+    return f"delay = {d:.3g} s < 0 (the plant would act before the command)" if d < 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:

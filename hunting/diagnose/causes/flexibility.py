@@ -11,10 +11,12 @@ NAME = "flexibility"
 DESCRIPTION = "an unmodelled resonance (load on a spring behind the measured side)"
 FAMILY = "inertia"
 HYPERS = 2
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 HYPER_KEYS = ("frequency", "damping")
 UNITS = {"load_mass": "kg", "frequency": "Hz", "damping": "", "stiffness": "N/m"}
 DAMPING = (0.02, 0.05, 0.1, 0.2, 0.4)
 DAMPING_MAX = (0.002, 1.0)            # the damping ratios the refinement may reach
+NOISE_MARGIN = 100.0                  # the acceleration power above the encoder noise's, in the band
 
 
 def hypers(kin, model) -> list:
@@ -37,6 +39,8 @@ def hypers(kin, model) -> list:
     fb, Pb = f[inside], P[inside]
     idx, _ = find_peaks(Pb)
     idx = sorted(idx, key=lambda i: -Pb[i])[:2]
+    # every third of a filter window among the moving samples: the regressor is smooth at that scale
+    m = np.flatnonzero(m)[::max(1, int(round(kin.window / dt)) // 3)]
     rm, am = r[m], kin.a
 
     def fit(z):
@@ -62,14 +66,18 @@ def hypers(kin, model) -> list:
         res = minimize(lambda z: min(ss(z), cap), z0, method="Nelder-Mead",
                        options=dict(xatol=1e-3, fatol=1e-9, maxiter=80))
         z = res.x if res.fun <= ss(z0) else z0
-        out.append({"frequency": float(np.exp(z[0])), "damping": float(np.exp(z[1]))})
+        f0, zeta = float(np.exp(z[0])), float(np.exp(z[1]))
+        # a fit that runs to the edge of the admissible set has found no resonance there
+        if zeta > 0.95 * DAMPING_MAX[1] or zeta < 1.05 * DAMPING_MAX[0] or f0 < 1.02 * lo or f0 > 0.98 * hi:
+            continue
+        out.append({"frequency": f0, "damping": zeta})
     return out
 
 
 def band(kin) -> tuple[float, float]:
     """(lowest, highest) resonance frequency [Hz] this record can show: from 2 Hz to a tenth of
     the sampling rate, and no higher than where the measured acceleration's spectrum falls below
-    ten times the part the position sensor's noise puts there (above it the acceleration, and
+    NOISE_MARGIN times the part the position sensor's noise puts there (above it the acceleration, and
     every regressor made of it, is the encoder's noise, and a "resonance" fits that noise in the
     force residual and the validation data alike)."""
     from scipy.signal import welch
@@ -80,7 +88,7 @@ def band(kin) -> tuple[float, float]:
         m = kin.moving
         f, P = welch(np.where(m, kin.a - kin.a[m].mean(), 0.0), fs=1.0 / dt, nperseg=min(4096, kin.a.size // 4))
         P = P * kin.a.size / max(m.sum(), 1)       # the PSD of the moving samples alone
-        ok = (f >= 2.0) & (P > 10 * acceleration_noise_psd(kin, f))
+        ok = (f >= 2.0) & (P > NOISE_MARGIN * acceleration_noise_psd(kin, f))
         above = f[(f >= 2.0) & ~ok]
         hi = min(hi, float(above[0]) if above.size else hi)
     return 2.0, hi

@@ -12,6 +12,8 @@ NAME = "lag"
 DESCRIPTION = "frictional memory: the Stribeck level lags the velocity (time constant)"
 FAMILY = "velocity"
 HYPERS = 0
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+EXCLUDES = ("reversal",)     # LuGre bristles have their own memory
 UNITS = {"lag": "s"}
 
 

@@ -5,6 +5,7 @@ NAME = "mass"
 DESCRIPTION = "mass (inertia)"
 FAMILY = "inertia"
 HYPERS = 0
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 UNITS = {"mass": "kg"}
 
 
@@ -14,6 +15,11 @@ def hypers(kin, model) -> list:
 
 def design(kin, model, hyper):
     return kin.a[:, None]
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    m = model.mass + float(theta[0])
+    return f"mass = {m:.3g} kg <= 0" if m <= 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:

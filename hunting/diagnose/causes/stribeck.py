@@ -50,6 +50,9 @@ def shift(kin, model, hyper) -> np.ndarray:
 
 def unphysical(theta, hyper, model) -> str | None:
     dip = min(model.curve.positive.Fs - model.curve.positive.Fc, model.curve.negative.Fs - model.curve.negative.Fc)
+    Fc = min(model.curve.positive.Fc, model.curve.negative.Fc) + float(theta[0])
+    if Fc < 0:
+        return f"Fc = {Fc:.3g} N < 0"
     if dip + theta[1] < 0:
         return (f"Fs - Fc = {dip + theta[1]:.3g} N < 0 (friction rising with speed at low speed); a force dip at "
                 "low speed through reversals is frictional memory (lag) or presliding, not a Stribeck curve")

@@ -8,6 +8,7 @@ NAME = "viscous"
 DESCRIPTION = "viscous coefficient b"
 FAMILY = "velocity"
 HYPERS = 0
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 UNITS = {"b": "N s/m"}
 
 
@@ -17,6 +18,11 @@ def hypers(kin, model) -> list:
 
 def design(kin, model, hyper):
     return kin.sliding(kin.vf)[:, None]
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    b = model.curve.positive.b + float(theta[0])
+    return f"b = {b:.3g} N s/m < 0 (friction that pushes along the motion)" if b < 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:
