@@ -217,6 +217,18 @@ class Library:
             k += X.shape[1]
         return out
 
+    def part(self, ex: Explanation, name: str, which: str) -> np.ndarray:
+        """One member's force change (n,) in a fitted explanation (prediction's terms)."""
+        k = 0
+        for nm, j in ex.members:
+            v = self.variants[nm][j]
+            kk = v.Xf.shape[1]
+            if nm == name:
+                X, s = {"f": (v.Xf, v.sf), "v": (v.Xv, v.sv), "r": (v.Xr, v.sr)}[which]
+                return X @ ex.theta[k:k + kk] + s
+            k += kk
+        raise KeyError(name)
+
     def validation_rms(self, ex: Explanation) -> float:
         r = (self.rv - self.prediction(ex, "v"))[self.used_v]
         return float(np.sqrt(np.mean(r ** 2)))
@@ -253,18 +265,20 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             rest = tuple(n for n in current.names if n != name)
             start = {n: j for n, j in current.members if n != name}
             without = lib.best_variants(rest, start) if rest else lib.fit([])
-            p_without = lib.prediction(without, "v")
-            e0 = (lib.rv - p_without)[Sv.idx]
-            yhat = (pred - p_without)[Sv.idx]
-            gamma, t, p = out_of_sample(e0, yhat, Sv.run, noise_v)
+            # the test: does this cause's part of the fitted explanation (the others' parts held)
+            # predict the validation residual the others leave?
+            own = lib.part(current, name, "v")
+            e0 = (lib.rv - pred + own)[Sv.idx]
+            gamma, t, p = out_of_sample(e0, own[Sv.idx], Sv.run, noise_v)
+            # the gain: the explanation refitted without it
             rms_wo = lib.validation_rms(without)
             tests[name] = dict(gamma=gamma, t=t, p_value=p, gain=rms_wo / max(rms_full, 1e-300) - 1,
                                rms_without=rms_wo, rms=rms_full, bic_without=without.bic)
             if lib.kr is not None and getattr(CAUSES[name], "NOISE_FED", False):
-                # the same prediction along the reference trajectory: free of the sensor's and the
+                # the same part along the instrument trajectory: free of the sensor's and the
                 # actuator's noise, which feedback puts into the measured regressors (a delay or
                 # mass "explaining" the loop's reaction to its own noise explains nothing here)
-                yr = (lib.prediction(current, "r") - lib.prediction(without, "r"))[Sv.idx]
+                yr = lib.part(current, name, "r")[Sv.idx]
                 tests[name]["p_reference"] = out_of_sample(e0, yr, Sv.run, noise_v)[2]
         failing = [n for n in current.names if tests[n]["p_value"] >= alpha or tests[n]["gain"] < min_gain
                    or tests[n].get("p_reference", 0.0) >= alpha_reference]

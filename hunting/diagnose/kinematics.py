@@ -37,8 +37,7 @@ from .data import Measurement
 class Kinematics:
     """(n,) arrays: t [s], q [m] (smoothed), v [m/s] (smoothed over the window), a [m/s^2]
     (H_a of the instantaneous acceleration on sliding samples), force [N] (H_a of the drive force
-    cm u + f_ext), du [N/s] (H_a of the drive force's rate on sliding samples); cm : motor
-    constant; window [s]; moving : samples used for the force balance (|v| above v_min, away from
+    cm u + f_ext); cm : motor constant; window [s]; moving : samples used for the force balance (|v| above v_min, away from
     the filter edges and from stops and break-aways by half a window); vf [m/s] : short-window velocity for the friction maps; a_inst [m/s^2] :
     second differences of q; drive [N] : cm u (aligned for the zero-order hold) + f_ext; slide :
     bool, the mass slides (not stuck); resolution, noise [m] : the position sensor's step and
@@ -49,7 +48,6 @@ class Kinematics:
     v: np.ndarray
     a: np.ndarray
     force: np.ndarray
-    du: np.ndarray
     cm: float
     window: float
     moving: np.ndarray
@@ -138,7 +136,6 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))
-    du = H(np.where(slide, np.gradient(drive, dt), 0.0))
     moving = np.abs(v) > v_min_frac * np.max(np.abs(v))
     edge = np.zeros(meas.n, bool)
     edge[w:-w] = True                    # drop the filter's edge samples
@@ -147,7 +144,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     change = np.zeros(meas.n, bool)
     change[1:] = slide[1:] != slide[:-1]
     moving &= edge & ~dilate(change, w // 2)
-    return Kinematics(meas.t, q, v, a, force, du, float(cm), w * dt, moving, vf, a_inst, drive, slide,
+    return Kinematics(meas.t, q, v, a, force, float(cm), w * dt, moving, vf, a_inst, drive, slide,
                       float(resolution), float(noise))
 
 
@@ -189,10 +186,11 @@ def map_uncertain(kin: Kinematics, model, r: np.ndarray | None = None) -> np.nda
     """bool (n,): samples whose residual the friction map's own uncertainty could dominate. At
     each sample the Stribeck level's slope |dg/dv| at vf times the velocity's uncertainty (the two
     derivative filters' disagreement |vf - v| plus vf's quantization noise) bounds the force
-    error of evaluating the map at vf; a used sample is uncertain when that bound, anywhere
-    within half a filter window, exceeds the residual's robust spread on the used samples (a
-    steep Stribeck dip crossed in a few milliseconds, at break-away or a reversal)."""
-    from scipy.ndimage import maximum_filter1d
+    error of evaluating the map at vf; a used sample is uncertain when that bound's mean over
+    the filter window around it exceeds the residual's robust spread on the used samples, or a
+    tenth of its RMS when an effect dominates it (a steep Stribeck dip crossed in a few
+    milliseconds, at break-away or a reversal)."""
+    from scipy.ndimage import uniform_filter1d
     dt = kin.dt
     w = int(round(kin.window / dt))
     wf = max(5, (w // 3) | 1)
@@ -205,13 +203,16 @@ def map_uncertain(kin: Kinematics, model, r: np.ndarray | None = None) -> np.nda
     slope = np.abs(np.where(kin.vf >= 0, pos.level_slope(kin.vf), neg.level_slope(kin.vf)))
     err = slope * (np.abs(kin.vf - kin.v) + sigma_v)
     err = np.where(kin.slide, err, 0.0)
-    env = maximum_filter1d(err, 2 * (w // 2) + 1)
+    # the filter spreads a sample's error over its window: its mean there bounds the residual's
+    env = uniform_filter1d(err, 2 * (w // 2) + 1)
     if r is None:
         r = residual(kin, model)
     used = kin.moving & np.isfinite(r)
     if used.sum() < 10:
         return np.zeros(kin.t.size, bool)
-    spread = 1.4826 * float(np.median(np.abs(r[used] - np.median(r[used]))))
+    # the residual's noise (robust spread), or a tenth of its RMS when an effect dominates it
+    spread = max(1.4826 * float(np.median(np.abs(r[used] - np.median(r[used])))),
+                 0.1 * float(np.sqrt(np.mean(r[used] ** 2))))
     return env > max(spread, 1e-300)
 
 

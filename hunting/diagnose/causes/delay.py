@@ -1,21 +1,34 @@
-"""Actuation delay tau: the plant receives cm u(t - tau) ~ cm u(t) - tau cm u'(t), so the
-residual gains tau cm u'(t) (first order in tau, valid while tau << the signal's time scales)."""
+"""Actuation delay tau: the plant receives cm u(t - tau) instead of cm u(t), so the residual gains
+cm u(t) - cm u(t - tau). The regressor at a trial delay tau is that difference divided by tau
+(the drive force's rate for small tau, linear interpolation between samples): its coefficient is
+tau itself when the trial is right, and the Gauss-Newton refinement of tau (``HYPER_KEYS``)
+makes the two agree for delays of many samples, where the first-order term tau cm u' is not
+enough."""
+import numpy as np
+
 from ._words import _q
 
 NAME = "delay"
 DESCRIPTION = "actuation or measurement delay"
 FAMILY = "velocity"
 HYPERS = 0
+HYPER_KEYS = ("tau",)
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 UNITS = {"delay": "s"}
 
 
 def hypers(kin, model) -> list:
-    return [{}]
+    return [{"tau": kin.dt}]
+
+
+def hyper_bounds(kin, model) -> dict:
+    return {"tau": (0.25 * kin.dt, 0.25 * kin.window + 20 * kin.dt)}
 
 
 def design(kin, model, hyper):
-    return kin.du[:, None]
+    tau = hyper["tau"]
+    late = np.interp(kin.t - tau, kin.t, kin.drive)
+    return kin.sliding((kin.drive - late) / tau)[:, None]
 
 
 def unphysical(theta, hyper, model) -> str | None:
@@ -24,7 +37,7 @@ def unphysical(theta, hyper, model) -> str | None:
 
 
 def parameters(theta, hyper, model) -> dict:
-    return {"delay": float(theta[0])}
+    return {"delay": float(model.delay + theta[0])}
 
 
 def extend(model, theta, hyper):

@@ -6,8 +6,9 @@ Rests are read from the measured positions (runs within two encoder counts for a
 :func:`hunting.diagnose.behaviour.stick_phases`) that end in motion before the record does; the
 record's first rest is skipped (how long the contact rested before it is unknown). At rest a = 0,
 so the force friction carries at the end of a rest is F = cm u + f_ext - offset - F_cog(q)
-(u aligned for the zero-order hold, averaged over the 10 ms before the position is two counts
-from its rest value: the break-away lies in that span); its excess over the model's break-away force in
+(u aligned for the zero-order hold; a straight line through the 10 ms before the position is two
+counts from its rest value, at its end: the break-away lies in that span, and the force ramps
+into it); its excess over the model's break-away force in
 the direction of the motion that follows is e_k. The extension fits
 
     e_k = level + gain (1 - exp(-t_k / time))     (t_k the rest's duration)
@@ -52,9 +53,13 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
             continue
         m = a + int(moved[0])         # the first sample two counts away: motion has begun
         tr.append((m - a) * dt)
-        # a digital loop's u is noisy (the velocity estimate of a quantized position); the
-        # break-away lies within the ~10 ms before the motion shows: average over that span
-        Fb.append(float(np.mean(F[m - span:m])))
+        # a digital loop's u is noisy (the velocity estimate of a quantized position) and ramps
+        # up to the break-away (an integral action at a rate set by the error at rest: faster for
+        # shorter rests, so a mean would fake a dwell effect); the break-away lies within the
+        # ~10 ms before the motion shows: a straight line through that span, at its end
+        k = np.arange(span, dtype=float)
+        slope, icpt = np.polyfit(k, F[m - span:m], 1)
+        Fb.append(float(icpt + slope * (span - 1)))
         # the motion follows the force that broke the contact away (the position's first step
         # decides only when that force is small)
         Fs = min(model.curve.positive.Fs, model.curve.negative.Fs)
