@@ -11,7 +11,7 @@ Stribeck level of that direction), and the regressor is the change of the fricti
 sigma0 z + sigma1 z' - sign(v) g(|v|) (sigma1 as in the extension: right after a reversal
 z' = 2 v, and the bristle damping dominates the transient). Its
 coefficient ``scale`` is 1 for LuGre: the whole level builds up after a reversal. A fit far from
-1 (outside [0.5, 2]) is a friction deficit near reversals of another kind, and the cause is
+1 (outside [0.3, 3]) is a friction deficit near reversals of another kind, and the cause is
 rejected as not physical.
 
 The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 as in
@@ -28,7 +28,7 @@ FAMILY = "inertia"
 HYPERS = 1
 HYPER_KEYS = ("sigma0",)
 UNITS = {"sigma0": "N/m", "scale": ""}
-SCALE_RANGE = (0.5, 2.0)
+SCALE_RANGE = (0.3, 3.0)
 
 
 @numba.njit(cache=True)
