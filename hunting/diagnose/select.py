@@ -158,7 +158,7 @@ class Diagnosis:
 
 
 def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
-             max_causes: int = 3, min_gain: float = 0.02, alpha: float = 1e-3, alpha_reference: float = 0.01,
+             max_causes: int = 3, min_gain: float = 0.05, alpha: float = 1e-3, alpha_reference: float = 0.01,
              window: float | None = None, behaviour: bool = True, progress=None) -> Diagnosis:
     """Rank the causes of the mismatch between the model and the measured data.
 
