@@ -58,8 +58,8 @@ def _naive(e0, yhat):
 def test_out_of_sample_test_holds_its_level_on_correlated_noise(kind):
     rng = np.random.default_rng({"ar1": 1, "ar2": 2, "hetero": 3}[kind])
     names = ("offset", "viscous", "mass", "delay")
-    Xf = {n: CAUSES[n].design(KF, MODEL, {})[SF.idx] for n in names}
-    Xv = {n: CAUSES[n].design(KV, MODEL, {})[SV.idx] for n in names}
+    Xf = {n: CAUSES[n].design(KF, MODEL, CAUSES[n].hypers(KF, MODEL)[0])[SF.idx] for n in names}
+    Xv = {n: CAUSES[n].design(KV, MODEL, CAUSES[n].hypers(KF, MODEL)[0])[SV.idx] for n in names}
     ours = {n: [] for n in names}
     naive = []
     for _ in range(DRAWS):

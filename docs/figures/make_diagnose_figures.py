@@ -1,20 +1,17 @@
 """The diagnosis figures: the EMPS worked example (its files in $HUNTING_DATA/emps or
-../shared/data/emps), the measured event maps of table 9.1 with a wrong Stribeck level, and with
-a results directory of the blind benchmark (benchmarks/blind/run.py) the detection rates against
-the effect's size (docs/diagnosis.md).
+../shared/data/emps) and the measured event maps of table 9.1 with a wrong Stribeck level. (The
+blind benchmark's figure, docs/figures/diagnose_blind_tuning.png, is benchmarks/blind/report.py's.)
 
-    python docs/figures/make_diagnose_figures.py [RESULTS_DIR SET_DIR]
+    python docs/figures/make_diagnose_figures.py
 """
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
 
 from hunting.diagnose import NominalModel, diagnose, load
 from hunting.diagnose.report import write_report
@@ -51,45 +48,6 @@ def table91_event_map() -> None:
     _report(dg, {"event_map.png": "diagnose_event_map.png"})
 
 
-def detection_rates(results: Path, sets: Path) -> None:
-    """Share of single-effect datasets whose cause is named first, against the effect's
-    validation gain when modelled exactly (the benchmark's effect size), per cause; and the
-    clean datasets' false alarms."""
-    from hunting.plotting import _plt, save
-    plt = _plt()
-    rows = []
-    for f in sorted(results.glob("d*.json")):
-        r = json.loads(f.read_text())
-        t = json.loads((sets / f.stem / "truth.json").read_text())
-        if len(t["effects"]) == 1:
-            e = t["effects"][0]
-            names = [c["name"] for c in r.get("causes", [])]
-            rows.append((e["cause"], e["gain"], bool(names) and names[0] in e["accept"]))
-    edges = np.array([-np.inf, 0.05, 0.15, 0.4, np.inf])
-    labels = ["< 0.05", "0.05-0.15", "0.15-0.4", ">= 0.4"]
-    causes = sorted({c for c, _, _ in rows})
-    fig, ax = plt.subplots(figsize=(9, 4.5))
-    for i, c in enumerate(causes):
-        g = np.array([x[1] for x in rows if x[0] == c])
-        hit = np.array([x[2] for x in rows if x[0] == c])
-        k = np.digitize(g, edges) - 1
-        rate = [hit[k == b].mean() if np.any(k == b) else np.nan for b in range(4)]
-        ax.plot(np.arange(4) + (i - len(causes) / 2) * 0.02, rate, "o-", ms=4, lw=1, label=c)
-    ax.set_xticks(range(4), labels)
-    ax.set_xlabel("validation gain of the effect when modelled exactly (the benchmark's effect size)")
-    ax.set_ylabel("named first")
-    ax.set_ylim(-0.05, 1.05)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    ax.set_title(f"blind benchmark ({results.name}): single effects named first against their size", fontsize=10)
-    fig.tight_layout()
-    save(fig, HERE / "diagnose_detection.png")
-    print("wrote", HERE / "diagnose_detection.png")
-
-
 if __name__ == "__main__":
-    if len(sys.argv) == 3:
-        detection_rates(Path(sys.argv[1]), Path(sys.argv[2]))
-    else:
-        emps()
-        table91_event_map()
+    emps()
+    table91_event_map()
