@@ -45,7 +45,7 @@ K_START, K_BACK, LOG10_EPS = 0.05, 0.615, -9.0
 def write_start(path: Path, K: float) -> None:
     """hunting's cycle at K as AUTO starting data: t, x1, x2, x3, sigma0 z at every step."""
     loop = preset("table8.1-lugre", K=K)
-    po = find_cycle("table8.1-lugre", {"K": K})
+    po = find_cycle("table8.1-lugre", params={"K": K}, throw=True).orbit
     tr = simulate(loop.system, po.x0, (0.0, po.period), rtol=1e-11, atol=1e-13)
     keep = np.concatenate([[True], np.diff(tr.t) > 1e-12])
     t, x = tr.t[keep], tr.x[keep].copy()
@@ -92,7 +92,7 @@ def main() -> None:
     rows = []
     # both methods start from the same cycle at K_START (AUTO from its sampled output), so
     # finding it is not timed
-    po = find_cycle("table8.1-lugre", {"K": K_START})
+    po = find_cycle("table8.1-lugre", params={"K": K_START}, throw=True).orbit
     follow("table8.1-lugre", "K", K_START, 0.06, orbit=po)               # load the compiled kernels
     # the reference fold: corrector tolerance 1e-10, flows at rtol 1e-12 (not timed)
     ref = hunting_branch(po, 1e-10, 1e-12)[1]

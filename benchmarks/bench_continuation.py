@@ -78,7 +78,7 @@ print = functools.partial(print, flush=True)  # noqa: A001
 
 def main() -> None:
     lp = preset("table8.1-lugre", K=0.3)
-    po = find_cycle("table8.1-lugre", {"K": 0.3})
+    po = find_cycle("table8.1-lugre", params={"K": 0.3}, throw=True).orbit
     x0 = po.x0 * np.array([1.0, 1.002, 1.002, 1.0])
     T0 = po.period * 1.001
     shoot(lp.system, x0, T0)                                  # compile / load
@@ -95,7 +95,7 @@ def main() -> None:
     print(f"  ratio: {t_s / t_h:.0f}x")
     # scipy baseline along the LuGre branch: natural-parameter shooting (each orbit from the last)
     # at K = 0.58, 0.60, 0.61, 0.62, 0.63, started from hunting's orbit at 0.58
-    start = find_cycle("table8.1-lugre", {"K": 0.58})       # a converged start helps the baseline
+    start = find_cycle("table8.1-lugre", params={"K": 0.58}, throw=True).orbit   # a converged start helps the baseline
     xk, Tk = start.x0.copy(), start.period
     K_ok, t_sc, per_orbit = None, 0.0, []
     for K in (0.58, 0.60, 0.61, 0.62, 0.63):

@@ -59,8 +59,14 @@ def main() -> None:
         return scipy_switch_sequence(1.0, 10.0, 10.0, 100.0, 4.0, 2.0, 0.1, 2.0, 1.0, 0.1, n_sticks,
                                      rtol=RTOL, atol=ATOL)
 
+    def run_unchecked():     # the same run without the growth check (status DIVERGED)
+        return hunting.simulate(loop.system, x0, (0.0, 1e3), rtol=RTOL, atol=ATOL, max_events=N_EVENTS,
+                                growth=None)
+
     run_hunting()  # compile / load from cache
     t_h, tr = best_of(run_hunting)
+    t_u, _ = best_of(run_unchecked, repeat=20)
+    t_h = min(t_h, best_of(run_hunting, repeat=20)[0])
     t_s, (d_s, _, nfev_s) = best_of(run_scipy, repeat=2)
     ref = hunting.simulate(loop.system, x0, (0.0, 1e3), rtol=1e-13, atol=1e-15, max_events=N_EVENTS)
     k_ref = ref.events.entering(S.STICK)
@@ -75,6 +81,7 @@ def main() -> None:
     print(f"  hunting.simulate : {t_h * 1e3:8.2f} ms  {tr.stats['n_fev']:7d} f evals  max stick-error deviation {err_h:.1e}")
     print(f"  scipy solve_ivp  : {t_s * 1e3:8.2f} ms  {nfev_s:7d} f evals  max stick-error deviation {err_s:.1e}")
     print(f"  speed ratio scipy / hunting: {t_s / t_h:.0f}x")
+    print(f"  growth check (status DIVERGED) cost: default / growth=None = {t_h / t_u:.3f}")
     print(f"  start-up (import + first simulate): cold compile {cold:.1f} s, cached {warm:.2f} s")
 
 

@@ -40,6 +40,8 @@ class Status(enum.IntEnum):
     NON_FINITE = 7         #: the vector field returned NaN or inf
     BUFFER_FULL = 8        #: internal: output buffers full (the front end resumes)
     INVALID_MODE = 9       #: a transition or mode function returned a mode out of range
+    DIVERGED = 10          #: the state grew by orders of magnitude (front end: simulate's ``growth``)
+    OUT_OF_BOUNDS = 11     #: the state left the bounds the caller gave (front end: simulate's ``bounds``)
 
     @property
     def ok(self) -> bool:
@@ -61,6 +63,11 @@ _ADVICE = {
     Status.NON_FINITE: "the vector field returned NaN or inf: check parameters and the state's range",
     Status.BUFFER_FULL: "output buffer full",
     Status.INVALID_MODE: "a transition or initial-mode function returned a mode index out of range",
+    Status.DIVERGED: ("the state grew by orders of magnitude: the loop is unstable with these parameters "
+                      "(check the controller gains, e.g. a negative or too small gain) or the run diverges; "
+                      "if growth is what you study, allow more (simulate's growth; None, or --growth 0: no check)"),
+    Status.OUT_OF_BOUNDS: ("the state left the bounds given: widen them if the motion is meant to go there, "
+                           "else check the parameters"),
 }
 
 

@@ -45,11 +45,41 @@ def _finish(fig, ax, own: bool, title: str, path) -> None:
             save(fig, path)
 
 
+THESIS_STYLE = dict(marker="x", color="C3", ms=9, mew=2.0, ls="none", zorder=6)
+
+
+def thesis_marks(ax, x, y, *, label: str = "thesis") -> None:
+    """The thesis' values as red crosses (one legend entry), beside ours."""
+    ax.plot(np.atleast_1d(x), np.atleast_1d(y), label=label, **THESIS_STYLE)
+
+
+def thesis_table(ax, rows, *, loc: str = "lower right", title: str = "", room: float = 0.0) -> None:
+    """A small table in the axes: for each row (label, thesis, ours, format) the thesis value
+    beside ours ("hunting"), so a figure carries the check it illustrates. ``room``: widen the
+    y range by this fraction on the table's side so that it does not cover the data."""
+    if room > 0:
+        lo, hi = ax.get_ylim()
+        span = hi - lo
+        ax.set_ylim((lo - room * span, hi) if loc.startswith("lower") else (lo, hi + room * span))
+    cells = [(label, thesis if isinstance(thesis, str) else format(thesis, fmt),
+              ours if isinstance(ours, str) else format(ours, fmt)) for label, thesis, ours, fmt in rows]
+    w0 = max(len(c[0]) for c in cells)
+    w1 = max(6, *(len(c[1]) for c in cells)) + 2
+    w2 = max(7, *(len(c[2]) for c in cells)) + 2
+    lines = [f"{'':<{w0}}{'thesis':>{w1}}{'hunting':>{w2}}"] + [f"{a:<{w0}}{b:>{w1}}{c:>{w2}}" for a, b, c in cells]
+    text = (title + "\n" if title else "") + "\n".join(lines)
+    pos = {"lower right": (0.98, 0.03, "right", "bottom"), "upper right": (0.98, 0.97, "right", "top"),
+           "lower left": (0.02, 0.03, "left", "bottom"), "upper left": (0.02, 0.97, "left", "top"),
+           "center right": (0.98, 0.5, "right", "center")}[loc]
+    ax.text(pos[0], pos[1], text, transform=ax.transAxes, ha=pos[2], va=pos[3], family="monospace", fontsize=7,
+            bbox=dict(boxstyle="round", fc="white", ec="0.6", alpha=0.9), zorder=10)
+
+
 def plot_trajectory(traj, *, title: str = "", stick_modes=(), units: dict | None = None, path=None):
     """Time responses of every state and a phase portrait (x1, x2, x3 in 3-D).
 
-    Stick phases (modes in ``stick_modes``) are shaded; event states are marked with circles.
-    Returns the figure; saves it when ``path`` is given."""
+    Stick phases (modes in ``stick_modes``) are shaded (with a legend entry); event states are
+    marked with circles. Returns the figure; saves it when ``path`` is given."""
     plt = _plt()
     units = units or {}
     n = traj.x.shape[1]
@@ -59,8 +89,10 @@ def plot_trajectory(traj, *, title: str = "", stick_modes=(), units: dict | None
     for i in range(n):
         ax = fig.add_subplot(gs[i, 0])
         ax.plot(traj.t, traj.x[:, i], lw=1.0, color="C0")
-        for a, b in intervals:
-            ax.axvspan(a, b, color="0.85", lw=0)
+        for j, (a, b) in enumerate(intervals):
+            ax.axvspan(a, b, color="0.85", lw=0, label="stick phase" if j == 0 else None)
+        if i == 0 and len(intervals):
+            ax.legend(fontsize=8, loc="best")
         name = traj.state_names[i] if traj.state_names else f"x{i + 1}"
         ax.set_ylabel(f"{name} [{units.get(name, '-')}]")
         ax.grid(alpha=0.3)
@@ -121,7 +153,7 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
     fig, ax, own = _axes(ax, (5.6, 5.0))
     k = em.iterate
     lab = "P(d)" if k == 1 else f"P$^{k}$(d)"
-    ax.plot(em.grid, em.image, ".", ms=2.0, color="C0", label=lab)
+    ax.plot(em.grid, em.image, ".", ms=2.0 if em.grid.size > 200 else 5.0, color="C0", label=lab)
     lo, hi = float(np.nanmin(em.grid)), float(np.nanmax(em.grid))
     ax.plot([lo, hi], [lo, hi], "-", color="0.4", lw=0.8, label="diagonal")
     ax.axhline(0, color="0.8", lw=0.6)
@@ -136,9 +168,13 @@ def plot_event_map(em, *, cobweb_from=None, cobweb_steps: int = 6, fixed=(), tit
             xs.append(float(mv.image[0]))
         ax.plot(*cobweb_path(xs), "-", color="C3", lw=0.9, label="cobweb")
         ax.plot(xs[:-1], xs[1:], "o", color="C3", ms=4)
+    labelled = set()
     for f in fixed:
         for d in ([f.d] if f.kind == "equilibrium" else [f.d, -f.d] if em.loop.odd and em.grid.min() < 0 else [f.d]):
-            ax.plot(d, d, "o", ms=7, mfc="k" if f.stable else "w", mec="k", zorder=5)
+            key = "stable" if f.stable else "unstable"
+            ax.plot(d, d, "o", ms=7, mfc="k" if f.stable else "w", mec="k", zorder=5,
+                    label=None if key in labelled else f"{key} fixed point")
+            labelled.add(key)
     ax.set_xlabel(f"d$^n$ [{unit}]")
     ax.set_ylabel(f"d$^{{n+{k}}}$ [{unit}]")
     ax.grid(alpha=0.3)
@@ -316,4 +352,81 @@ def plot_attractor_diagram(values, attractors_per_value, *, param: str = "K", ti
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     _finish(fig, ax, own, title, path)
+    return fig
+
+
+def plot_cycle(result, system, *, periods: int = 2, units: dict | None = None, title: str = "", path=None):
+    """A periodic orbit (a :class:`hunting.continuation.CycleResult`): each state over
+    ``periods`` periods from its x0 with the stick phases of every contact shaded, and a phase
+    portrait of one period with the stick segments drawn thick.
+
+    ``system`` is the PiecewiseSystem the result belongs to (at the result's parameters).
+    Returns the figure; saves it when ``path`` is given."""
+    from .integrate.simulate import simulate
+    plt = _plt()
+    units = units or {}
+    T = float(result.period)
+    names = list(result.state_names)
+    n = len(names)
+    tr = simulate(system, result.x0_array, (0.0, periods * T), mode0=result.mode0,
+                  t_eval=np.linspace(0.0, periods * T, 2000 * periods + 1), rtol=1e-10, atol=1e-13)
+    contacts = sorted({p.contact for p in result.phases})
+    colors = {c: col for c, col in zip(contacts, ("0.82", "#f2c98a", "#a9d3a5", "#c7b7e0"))}
+    fig = plt.figure(figsize=(11, 1.9 * max(n, 3) + 0.6))
+    gs = fig.add_gridspec(n, 2, width_ratios=[1.5, 1])
+    for i, name in enumerate(names):
+        ax = fig.add_subplot(gs[i, 0])
+        labelled = set()
+        for k in range(periods):
+            for p in result.phases:
+                if p.kind != "stick":
+                    continue
+                for a in (p.start + k * T, p.start + (k - 1) * T):      # a phase may wrap the period
+                    lo, hi = max(a, 0.0), min(a + p.duration, periods * T)
+                    if hi > lo:
+                        lab = None
+                        if i == 0 and p.contact not in labelled:
+                            lab = "stick" if len(contacts) == 1 else f"stick ({p.contact})"
+                            labelled.add(p.contact)
+                        ax.axvspan(lo, hi, color=colors[p.contact], lw=0, label=lab)
+        ax.plot(tr.t, tr.x[:, i], lw=1.0, color="C0")
+        for k in range(1, periods):
+            ax.axvline(k * T, color="0.4", lw=0.6, ls="--", label="period" if (i == 0 and k == 1) else None)
+        ax.set_ylabel(f"{name} [{units[name]}]" if name in units else name)
+        ax.set_xlim(0.0, periods * T)
+        ax.grid(alpha=0.3)
+        if i == 0:
+            ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+        if i == n - 1:
+            ax.set_xlabel("t from x0 [s]")
+    # phase portrait: the first two states among those that move most relative to their size
+    rng = np.array([result.maximum[k] - result.minimum[k] for k in names])
+    size = np.maximum(np.array([max(abs(result.maximum[k]), abs(result.minimum[k])) for k in names]), 1e-300)
+    rel = rng / size
+    big = [k for k in range(n) if rel[k] >= 0.5 * rel.max()] + [k for k in range(n) if rel[k] < 0.5 * rel.max()]
+    i, j = (big[0], big[1]) if n >= 2 else (0, 0)
+    ax = fig.add_subplot(gs[:, 1])
+    one = tr.t <= T
+    ax.plot(tr.x[one, i], tr.x[one, j], lw=1.0, color="C0", label="slip")
+    st = np.zeros(tr.t.size, dtype=bool)
+    for p in result.phases:
+        if p.kind == "stick":
+            rel_t = (tr.t - p.start) % T
+            st |= rel_t <= p.duration
+    if np.any(st & one):
+        ax.plot(np.where(st, tr.x[:, i], np.nan)[one], np.where(st, tr.x[:, j], np.nan)[one], lw=3.0,
+                color="C3", label="stick")
+    ax.plot([result.x0[names[i]]], [result.x0[names[j]]], "o", color="k", ms=5, label="x0")
+    ax.set_xlabel(f"{names[i]} [{units[names[i]]}]" if names[i] in units else names[i])
+    ax.set_ylabel(f"{names[j]} [{units[names[j]]}]" if names[j] in units else names[j])
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    lam = list(result.multipliers)
+    if lam:
+        lam.pop(int(np.argmin(np.abs(np.array(lam) - 1.0))))        # the trivial multiplier
+    fig.suptitle(title or f"{result.label}: {'stable' if result.stable else 'unstable'} cycle, period {T:.6g} s"
+                 + (f", largest |lambda| besides 1: {max(np.abs(lam)):.3g}" if lam else ""), fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        save(fig, path)
     return fig

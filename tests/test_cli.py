@@ -100,6 +100,7 @@ BAD = [
     ("continue table9.1 --param P --from 10 --to 12 --set P=3", "also given in --set"),
     ("continue table9.1 --param D --from -1 --to 1", "D = -1.0 is not allowed"),
     ("continue table9.1 --param P --from 10 --to 12 --plot /nonexistent/b.png", "does not exist"),
+    ("continue table9.1 --param P --from 10 --to 12 --json /nonexistent/b.json", "does not exist"),
     # reproduce and demo
     ("reproduce ch7", "invalid choice: 'ch7'"),
     ("reproduce ch9 --out /proc/nope", "--out '/proc/nope'"),
@@ -111,6 +112,7 @@ BAD = [
     ("diagnose {tmp}/data.csv --model {tmp}/model.json --json {tmp}/data.csv", "same path as DATA"),
     ("diagnose {tmp}/data.csv --model {tmp}/model.json --report /proc/nope", "--report '/proc/nope'"),
     ("diagnose {tmp}/data.csv --model {tmp}/model.json --validate {tmp}", "--validate"),
+    ("diagnose {tmp}/data.csv --model {tmp}/model.json --json /nonexistent/d.json", "does not exist"),
     # the command itself
     ("", "required: COMMAND"),
     ("frobnicate", "invalid choice: 'frobnicate'"),
@@ -124,6 +126,18 @@ def test_bad_input_is_one_line_and_exit_2(capsys, files, argv, expected):
     line = one_line_error(err)
     assert code == 2, line
     assert expected.format(tmp=files) in line
+
+
+def test_diagnose_failures_inside_the_command_are_one_line(capsys, files):
+    """--drop u and a ragged CSV (the diagnosis' own messages may change; the boundary keeps
+    them to one line without a traceback)."""
+    (files / "model.json").write_text(json.dumps({"plant": {"mass": 95.0, "motor_constant": 35.15},
+                                                  "friction": {"law": "coulomb-viscous", "Fc": 20.0, "b": 200.0}}))
+    (files / "ragged.csv").write_text("t,q,u\n0,0,0\n0.001,0\n0.002,0,0,5\n")
+    for argv in (f"diagnose {files}/data.csv --model {files}/model.json --drop u",
+                 f"diagnose {files}/ragged.csv --model {files}/model.json"):
+        code, _, err = run_main(capsys, argv.split())
+        assert code in (1, 2) and one_line_error(err)
 
 
 def test_at_least_forty_bad_inputs_are_covered():
@@ -268,3 +282,104 @@ def test_grid_is_linspace(a, width, n):
     if not a + width > a:
         return
     assert np.array_equal(B.grid(text), np.linspace(a, a + width, n))
+
+
+# ---------------------------------------------------------------- status, not success
+def test_unstable_gains_end_with_diverged_not_success():
+    lp = hunting.preset("table9.1", P=-5)
+    tr = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0))
+    assert tr.status == hunting.Status.DIVERGED and not tr.success
+    assert 1e6 < np.max(np.abs(tr.x_final)) < 1e7 and tr.t_final < 5      # ends at the first point beyond
+    assert np.max(np.abs(tr.x[:-1])) <= 1e6 and "controller gains" in tr.message
+    free = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), growth=None)
+    assert free.status == hunting.Status.SUCCESS and np.max(np.abs(free.x_final)) > 1e70
+    sparse = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), t_eval=np.linspace(0, 30, 7))
+    assert sparse.status == hunting.Status.DIVERGED and sparse.t[-1] == 5.0
+    with pytest.raises(hunting.ConvergenceError, match="DIVERGED|grew by orders of magnitude"):
+        hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), throw=True)
+
+
+def test_bounds_end_the_run_at_the_first_point_beyond_them():
+    lp = hunting.preset("table9.1")
+    tr = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0), bounds=[0.2, np.inf, np.inf])
+    assert tr.status == hunting.Status.OUT_OF_BOUNDS and "x1" in tr.message
+    assert abs(tr.x[-1, 0]) > 0.2 and np.all(np.abs(tr.x[:-1, 0]) <= 0.2)
+    assert tr.events.t.size == 0 or tr.events.t[-1] <= tr.t_final
+    full = hunting.simulate(lp.system, [0.1, 0.0, 0.0], (0.0, 30.0))
+    assert full.success and np.allclose(full.x[: tr.x.shape[0] - 1], tr.x[:-1])
+
+
+def test_simulate_names_a_bad_x0_and_bad_limits():
+    sy = hunting.preset("table9.1").system
+    for x0 in ("abc", [1, "a", 2], {"a": 1}):
+        with pytest.raises(hunting.SystemDefinitionError, match=r"x0 = .* is not allowed: x0 must be 3 finite numbers"):
+            hunting.simulate(sy, x0, (0, 1))
+    for kw, text in ((dict(growth=0.5), "growth = 0.5"), (dict(bounds=-1), "bounds = -1"),
+                     (dict(bounds=[1, 2]), "bounds = \\[1, 2\\]")):
+        with pytest.raises(hunting.SystemDefinitionError, match=text):
+            hunting.simulate(sy, [0.1, 0, 0], (0, 1), **kw)
+
+
+def test_cli_warns_up_front_and_exits_1_on_divergence(capsys):
+    code, out, err = run_main(capsys, ["simulate", "table9.1", "--set", "P=-5", "--x0", "0.1,0,0"])
+    assert code == 1 and out.startswith("DIVERGED") and "SUCCESS" not in out
+    assert "warning: the linear loop without friction is unstable" in err
+    code, out, err = run_main(capsys, ["simulate", "table9.1", "--x0", "0.1,0,0", "--t", "2"])
+    assert code == 0 and "warning" not in err
+
+
+# ---------------------------------------------------------------- values that start with a minus sign
+@pytest.mark.parametrize("argv, dest, expected", [
+    ("simulate table9.1 --x0 -0.1,0,0", "x0", (-0.1, 0.0, 0.0)),
+    ("simulate table9.1 --x0 -1e-1", "x0", (-0.1,)),
+    ("simulate table9.1 --x0 -.1,-2E-3", "x0", (-0.1, -2e-3)),
+    ("simulate table9.1 --x0 x1=-0.1,x3=-1", "x0", (-0.1, -1.0)),
+    ("cycle table9.1 --x0 -0.1,0,0", "x0", (-0.1, 0.0, 0.0)),
+    ("eventmap table9.1 --grid -0.5:0.5:11", "grid", -0.5),
+    ("continue table9.1 --param P --from -1e-3 --to -2.5E2 --back-to -7", "start", -1e-3),
+    ("continue table9.1 --param P --from 1 --to -2.5E2", "end", -250.0),
+    ("continue table9.1 --param P --from 1 --to 2 --back-to -.5", "back_to", -0.5),
+    ("simulate table9.1 --growth -1", "growth", -1.0),
+    ("simulate table9.1 --set P=-5", "set", [("P", "-5")]),
+])
+def test_values_may_start_with_a_minus_sign(argv, dest, expected):
+    args = hunting.cli.build_parser().parse_args(argv.split())
+    got = getattr(args, dest)
+    if dest == "x0":
+        got = got.values
+    elif dest == "grid":
+        got = got[0]
+    assert got == expected
+
+
+@pytest.mark.parametrize("argv, expected", [
+    ("cycle table9.1 --period-guess -1", "argument --period-guess: '-1' is not allowed: a finite number > 0"),
+    ("simulate table9.1 --t -1e3", "argument --t: '-1e3' is not allowed"),
+    ("simulate table9.1 --t -inf", "argument --t: '-inf' is not allowed"),
+    ("simulate table9.1 --json -o.json", "--json: expected one argument (to give a value that starts with '-', "
+                                         "write --json=-...)"),
+])
+def test_a_negative_value_where_none_is_allowed_names_the_option(capsys, argv, expected):
+    code, _, err = run_main(capsys, argv.split())
+    assert code == 2 and expected in one_line_error(err)
+
+
+def test_simulate_from_a_negative_start(capsys):
+    code, out, _ = run_main(capsys, ["simulate", "table9.1", "--x0", "-0.1,0,0", "--t", "3"])
+    assert code == 0 and out.startswith("SUCCESS")
+
+
+def test_pgf_without_tex_is_refused_before_computing(monkeypatch, capsys, tmp_path):
+    """`--plot f.pgf` needs the TeX program of matplotlib's pgf backend (was: a RuntimeError after
+    the computation, the figure lost)."""
+    import shutil
+
+    import hunting.integrate
+
+    def computed(*a, **k):
+        raise AssertionError("computed before checking the outputs")
+    monkeypatch.setattr(hunting.integrate, "simulate", computed)
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    code, _, err = run_main(capsys, ["simulate", "table9.1", "--plot", str(tmp_path / "f.pgf")])
+    line = one_line_error(err)
+    assert code == 2 and "writing .pgf needs the TeX program 'xelatex'" in line and ".png" in line

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from hunting.continuation import ContinuationOptions, continue_orbit, cycle_guess, fd_jacobian, flow, shoot
+from hunting.continuation import ContinuationOptions, continue_orbit, fd_jacobian, find_cycle, flow, shoot
 from hunting.continuation.shooting import guess_from_stick_error
 from hunting.eventmap import fixed_points
 from hunting.models import preset
@@ -79,11 +79,9 @@ def _switch_cycle(K):
     return lp, shoot(lp.system, x0, T)
 
 
-def test_cycle_guess_from_a_long_simulation():
-    lp = preset("table8.1-switch", K=0.3)
-    x0, T = cycle_guess(lp.system, lp.state(x1=-1.0), t_settle=100.0)
-    po = shoot(lp.system, x0, T)
-    assert po.success and po.period == pytest.approx(14.3081346, rel=1e-6)
+def test_cycle_from_a_long_simulation():
+    res = find_cycle("table8.1-switch", {"x1": -1.0}, params={"K": 0.3})
+    assert res.success and "transient" in res.start and res.period == pytest.approx(14.3081346, rel=1e-6)
 
 
 def test_switch_cycle_is_the_event_map_fixed_point_and_multiplier_is_its_slope():

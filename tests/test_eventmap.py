@@ -7,7 +7,8 @@ import pytest
 import hunting
 from hunting import analysis as A
 from hunting.cli import main
-from hunting.eventmap import (basins, evaluate_map, event_map, fixed_points, map_diagram, stick_map)
+from hunting.eventmap import (basins, check_resolution, evaluate_map, event_map, fixed_points, linear_origin,
+                              map_diagram, origin_slope, stick_map)
 from hunting.models import servo as S
 
 GRID = np.linspace(0.0, 0.5, 501)
@@ -167,6 +168,11 @@ def test_reproduce_ch9_matches_the_thesis(tmp_path):
     assert run(tmp_path) == 0
     data = json.loads((tmp_path / "ch9.json").read_text())
     assert all(r["ok"] for r in data["checks"]) and len(data["checks"]) >= 30
+    facts = {r["check"]: r for r in data["checks"] if isinstance(r["ours"], bool)}
+    # a label that claims "unstable" carries True where the thesis has it unstable (Tables 9.2-9.4)
+    for label in ("d2* unstable", "beta=1: equilibrium set unstable", "beta=0.5: equilibrium set unstable",
+                  "discontinuous: equilibrium set unstable"):
+        assert facts[label]["ours"] is True and facts[label]["thesis"] is True, label
     for name in ("fig9_4", "fig9_5", "fig9_6", "fig9_7", "fig9_8", "fig11_1", "fig11_3"):
         assert (tmp_path / f"{name}.png").stat().st_size > 20000
 
@@ -188,3 +194,87 @@ def test_attractors_find_the_table_9_2_cycle_and_the_equilibrium():
     assert eq.basin == 2
     with pytest.raises(hunting.SystemDefinitionError, match="starts"):
         attractors(loop, [np.nan])
+
+
+# ---------------------------------------------------------------- the slope at the equilibrium set
+def _secant(loop, k, delta):
+    """P^k(delta)/delta and P^k(-delta)/(-delta): finite differences of the true map at 0."""
+    mv = evaluate_map(loop, [delta, -delta], k)
+    return mv.image[0] / delta, mv.image[1] / -delta
+
+
+@pytest.mark.parametrize("name, kw, k, delta, rtol", [
+    ("table9.1", dict(), 2, 4e-8, 2e-6),                # beta = 2: P^2(d)/d = slope + O(d)
+    ("table9.1", dict(Fc=4.0), 2, 1e-3, 1e-8),          # Coulomb: P^2 is linear, exact
+    ("table9.1", dict(beta=1.0, P=27.0), 2, 1e-9, 1e-4),  # beta = 1: the Stribeck slope enters
+    ("table9.1", dict(Fs_neg=5.0, b_neg=2.0), 1, 4e-8, 1e-5),   # direction-dependent: two sides
+    ("limms-switch", dict(K=55.0), 1, 3e-8, 1e-5),      # cogging stiffness alpha at the setpoint
+])
+def test_slope_at_the_origin_from_the_linearization_matches_fine_differences(name, kw, k, delta, rtol):
+    loop = hunting.preset(name, **kw)
+    lin = linear_origin(loop, k)
+    right, left = _secant(loop, k, delta)
+    assert lin.slope_right == pytest.approx(right, rel=rtol)
+    assert lin.slope_left == pytest.approx(left, rel=rtol)
+
+
+def test_slope_at_the_origin_is_the_thesis_value_and_decides_stability():
+    eq = origin_slope(hunting.preset("table9.1"), 2)
+    assert eq.method == "linearization" and eq.slope_right == pytest.approx(0.857, abs=5e-4)   # Table 9.2
+    # beta = 1: unstable up to P = 26, stable from P = 27 (Fig. 9.8, confirmed in TARGETS)
+    assert origin_slope(hunting.preset("table9.1", beta=1.0, P=26.0), 2).slope_right == pytest.approx(1.0818, abs=1e-4)
+    assert origin_slope(hunting.preset("table9.1", beta=1.0, P=27.0), 2).stable
+    assert not origin_slope(hunting.preset("table9.1", beta=1.0, P=26.0), 2).stable
+    # no linearization for beta < 1 and the discontinuous curve: probes see the jump
+    assert linear_origin(hunting.preset("table9.1", beta=0.5), 2) is None
+    disc = origin_slope(hunting.preset("table9.1", beta="inf"), 2)
+    assert disc.method == "probes" and disc.behaviour == "discontinuous" and not disc.stable
+    # an unstable linear loop: the linearized slip never returns to stick, the slope is unbounded
+    assert origin_slope(hunting.preset("table9.1", P=-5.0), 2).behaviour == "steep"
+    # the linearized slip decays onto the equilibrium set without returning: P^k(d) = o(d)
+    sw = hunting.preset("table8.1-switch", K=0.2)
+    assert linear_origin(sw, 2).slope_right == 0.0 and origin_slope(sw, 2).stable
+    assert abs(_secant(sw, 1, 1e-5)[0]) < 1e-6
+
+
+# ---------------------------------------------------------------- grids that cannot resolve the map
+def _analyse(grid, **kw):
+    loop = hunting.preset("table9.1", **kw)
+    em = event_map(loop, grid, 2, derivative=False)
+    return check_resolution(em, fixed_points(loop, grid, 2, emap=em))
+
+
+def test_a_grid_far_too_coarse_keeps_the_equilibrium_stable_and_says_so():
+    res = _analyse(np.linspace(0.0, 1e6, 11))
+    eq = next(f for f in res.fixed if f.kind == "equilibrium")
+    assert eq.stable and eq.slope == pytest.approx(0.8568, abs=1e-4)        # was "unstable, slope 1.40"
+    text = " ".join(res.warnings)
+    assert "does not resolve the map" in text and "every image lies within" in text
+    a, b, n = res.suggested_grid
+    assert a == 0 and 0.64 < b < 1.0 and n >= 400
+    again = _analyse(np.linspace(a, b, n))                  # the suggestion resolves it
+    assert again.ok and [round(f.d, 4) for f in again.fixed if f.kind == "cycle"] == [0.0034, 0.2523]
+
+
+def test_a_cycle_between_the_origin_and_the_first_grid_point_is_found_and_flagged():
+    res = _analyse(np.linspace(0.0, 0.5, 11))
+    cyc = [f for f in res.fixed if f.kind == "cycle"]
+    assert [(round(f.d, 5), f.stable) for f in cyc] == [(0.00336, False), (0.2523, True)]
+    assert cyc[0] in res.unbracketed and any("0.0033558" in w for w in res.warnings)
+    a, b, n = res.suggested_grid
+    assert _analyse(np.linspace(a, b, n)).ok
+
+
+@pytest.mark.parametrize("kw", [dict(), dict(beta="inf"), dict(beta=1.0)])
+def test_the_thesis_grid_resolves_the_thesis_maps(kw):
+    assert _analyse(GRID, **kw).warnings == []
+
+
+def test_cli_eventmap_reports_resolution_warnings(tmp_path, capsys):
+    js = tmp_path / "m.json"
+    assert main(["eventmap", "table9.1", "--grid", "0:1e6:11", "--iterate", "2", "--json", str(js)]) == 0
+    out, err = capsys.readouterr()
+    assert "equilibrium" in out and "stable" in out and "unstable" not in out
+    assert "hunting: warning: suggested grid: 0:0.81:501" in err
+    data = json.loads(js.read_text())
+    assert data["suggested_grid"] == "0:0.81:501" and any("does not resolve" in w for w in data["warnings"])

@@ -1,20 +1,28 @@
 """The ``hunting`` command.
 
     hunting models                      presets and their parameters with units
-    hunting simulate PRESET [--set NAME=VALUE ...] [--x0 X1,X2,X3] [--t T] [--json F] [--plot F]
+    hunting simulate PRESET [--set NAME=VALUE ...] [--x0 X1,X2,X3] [--t T] [--method M] [--rtol R]
+                     [--atol A] [--max-steps N] [--max-events N] [--max-samples N] [--json F] [--plot F]
     hunting eventmap PRESET [--set NAME=VALUE ...] --grid START:STOP:N [--iterate K]
                      [--json FILE] [--plot FILE]
     hunting continue PRESET [--set NAME=VALUE ...] --param NAME --from A --to B [--back-to C]
-                     [--json FILE] [--plot FILE]
+                     [--max-points N] [--ds-max S] [--ds-min S] [--json FILE] [--plot FILE]
+                                        exit 1 when the branch stops short of B
+    hunting cycle PRESET [--set NAME=VALUE ...] [--x0 NAME=V,...] [--period-guess T]
+                     [--which stable|unstable] [--t-max T] [--d-max D] [--json FILE] [--plot FILE]
+                                        a periodic orbit: period, multipliers, stick phases
+    (simulate, eventmap, continue and cycle take --model FILE, a model description, instead
+    of PRESET)
     hunting reproduce ch8|ch9|ch10 [--out DIR]   a thesis chapter: tables and figures, checked
     hunting demo [--out DIR]            short simulations of chapters 4, 8 and 9, checked
     hunting diagnose DATA --model MODEL.json [--validate DATA2] [--json FILE] [--report DIR]
                      [--names KEY=COLUMN,...] [--drop COLUMN]   measured data against the model
 
 Every command checks its arguments and output paths before computing, writes result files
-whole (a temporary file, then a rename; ``--json -`` writes to standard output) and reports a
-failure in one line: exit code 2 for bad input, 1 for a numerical failure. ``--debug`` shows
-the traceback.
+whole (a temporary file, then a rename; devices, FIFOs and ``/dev/stdout`` directly, see
+:mod:`hunting._atomic`; ``--json -`` writes to standard output) and reports a failure in one
+line, in the command line's words (:mod:`hunting.cli.advice`): exit code 2 for bad input, 1 for
+a numerical failure. ``--debug`` shows the traceback.
 
 A command is a module in this package with ``NAME``, ``HELP``, ``add_arguments(parser)``,
 ``run(args, results) -> exit code`` and optionally ``files(args) -> (outputs, inputs)``; it is
@@ -29,11 +37,14 @@ import logging
 import os
 import sys
 import traceback
+import warnings
 
+from .._atomic import OutputPathError
 from ..errors import ConvergenceError, HuntingError
-from .boundary import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, ArgumentParser, Results, check_files
+from .advice import Command, command_of, for_cli
+from .boundary import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, ArgumentParser, Results, check_files, names_stdout
 
-COMMANDS = ("models", "simulate", "eventmap", "continue_", "reproduce", "demo", "diagnose")
+COMMANDS = ("models", "simulate", "eventmap", "continue_", "cycle", "reproduce", "demo", "diagnose")
 EXIT_BROKEN_PIPE = 141          # what a shell reports for a command ended by SIGPIPE
 
 
@@ -50,8 +61,9 @@ def build_parser() -> ArgumentParser:
     ap.add_argument("--version", action="version", version=f"hunting {__version__}")
     ap.add_argument("--debug", action="store_true", help="show the traceback of a failure")
     sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    ap.commands = {}
     for name, mod in _commands().items():
-        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
+        p = ap.commands[name] = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
         p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help="show the traceback of a failure")
         mod.add_arguments(p)
@@ -59,15 +71,20 @@ def build_parser() -> ArgumentParser:
 
 
 class _OneLine(logging.Formatter):
+    def __init__(self, words=None):
+        super().__init__()
+        self._words = words or (lambda text: text)
+
     def format(self, record):
-        return f"hunting: {record.levelname.lower()}: {record.getMessage()}"
+        return f"hunting: {record.levelname.lower()}: {self._words(record.getMessage())}"
 
 
 @contextlib.contextmanager
-def _warnings_to_stderr():
-    """Library warnings (logging) printed as 'hunting: warning: ...' on stderr while a command runs."""
+def _warnings_to_stderr(words=None):
+    """Library warnings (logging) printed as 'hunting: warning: ...' on stderr while a command
+    runs, in the command line's words (``words``: text -> text)."""
     h = logging.StreamHandler(sys.stderr)
-    h.setFormatter(_OneLine())
+    h.setFormatter(_OneLine(words))
     h.setLevel(logging.WARNING)
     logger = logging.getLogger("hunting")
     logger.addHandler(h)
@@ -77,8 +94,21 @@ def _warnings_to_stderr():
         logger.removeHandler(h)
 
 
-def _say_error(message: str) -> None:
-    one_line = " ".join(str(message).split())
+@contextlib.contextmanager
+def _python_warnings_one_line():
+    """Python warnings (numpy's RuntimeWarning from inside a computation) as one line each on
+    stderr, not the two-line source listing."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        where = os.path.splitext(os.path.basename(filename))[0]
+        print(f"hunting: warning: {message} ({category.__name__} in {where})", file=sys.stderr)
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        yield
+
+
+def _say_error(message: str, command: Command | None = None) -> None:
+    message = for_cli(str(message), command) if command is not None else str(message)
+    one_line = " ".join(message.split())
     print(f"hunting: error: {one_line}", file=sys.stderr)
 
 
@@ -93,19 +123,22 @@ def main(argv=None) -> int:
     """Run the command line; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in argv
+    command = None                          # the command, once known: its messages in its words
     try:
+        parser = build_parser()
         try:
-            args = build_parser().parse_args(argv)
+            args = parser.parse_args(argv)
         except SystemExit as e:             # --help and --version
             return int(e.code or 0)
+        command = args.cli_command = command_of(args, parser)
         cmd = _commands()[args.cmd]
         outputs, inputs = cmd.files(args) if hasattr(cmd, "files") else ((), ())
         check_files(outputs, inputs)
-        to_stdout = any(o.value == "-" for o in outputs)
+        to_stdout = any(names_stdout(o.value) for o in outputs)
         results = Results(sys.stdout)
         # with results on stdout, everything a command says goes to stderr
         redirect = contextlib.redirect_stdout(sys.stderr) if to_stdout else contextlib.nullcontext()
-        with _warnings_to_stderr(), redirect:
+        with _warnings_to_stderr(lambda text: for_cli(text, command)), _python_warnings_one_line(), redirect:
             code = cmd.run(args, results)
         sys.stdout.flush()
         return code
@@ -118,17 +151,20 @@ def main(argv=None) -> int:
     except ConvergenceError as e:
         if debug:
             traceback.print_exc()
-        _say_error(str(e))
+        _say_error(str(e), command)
         return EXIT_FAILURE
     except (HuntingError, ValueError) as e:
         if debug:
             traceback.print_exc()
-        _say_error(str(e))
+        _say_error(str(e), command)
         return EXIT_USAGE
     except OSError as e:                    # a file system failure while writing results
         if debug:
             traceback.print_exc()
-        _say_error(f"{e.strerror or e}" + (f": '{e.filename}'" if e.filename else ""))
+        if isinstance(e, OutputPathError):
+            _say_error(f"'{e.filename}' {e.strerror}", command)
+        else:
+            _say_error(f"{e.strerror or e}" + (f": '{e.filename}'" if e.filename else ""), command)
         return EXIT_FAILURE
     except Exception as e:  # noqa: BLE001 -- the last line of defence: one line, never a traceback
         if debug:

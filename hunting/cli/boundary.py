@@ -9,14 +9,18 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import errno
 import os
+import re
+import shutil
+import stat
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_path
+from .._atomic import atomic_path, output_target
 from ..errors import HuntingError
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
@@ -27,10 +31,27 @@ class UsageError(HuntingError, ValueError):
     """A command-line argument that is not allowed (exit code 2)."""
 
 
+# What argparse takes for a value, not an option, when it starts with "-": a number in any
+# spelling (-1, -.5, -1e-3, -0.1,0,0 for --x0, -0.5:0.5:11 for --grid, -inf). argparse's own
+# pattern accepts only -1 and -.5 forms, so "--x0 -0.1,0,0" failed with "expected one argument".
+# No option of the command line starts with "-" and a digit, so nothing is lost.
+_NEGATIVE_VALUE = re.compile(r"^-(?:\.?[0-9]|inf|nan)", re.IGNORECASE)
+_NO_VALUE = re.compile(r"^argument ((?:-\w|--[\w-]+)(?:/[\w-]+)*): expected one argument$")
+
+
 class ArgumentParser(argparse.ArgumentParser):
-    """argparse, but a bad argument raises :class:`UsageError` (one line, no usage block)."""
+    """argparse, but a bad argument raises :class:`UsageError` (one line, no usage block), and
+    values may start with a minus sign (``--x0 -0.1,0,0``, ``--grid -0.5:0.5:11``)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_VALUE      # argparse's hook (3.8-3.13)
 
     def error(self, message):
+        m = _NO_VALUE.match(message)
+        if m:                       # e.g. "--json -out.json": a value that looks like an option
+            flag = m.group(1).split("/")[-1]
+            message += f" (to give a value that starts with '-', write {flag}=-...)"
         raise UsageError(f"{message} (see '{self.prog} --help')")
 
 
@@ -61,15 +82,24 @@ def positive_float(text: str) -> float:
     return v
 
 
-def positive_int(text: str) -> int:
-    """An integer >= 1."""
+def _int_at_least(text: str, low: int) -> int:
     try:
         v = int(text.strip())
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer (allowed: an integer >= 1)") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: an integer >= 1 is required")
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer (allowed: an integer >= {low})") from None
+    if v < low:
+        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: an integer >= {low} is required")
     return v
+
+
+def positive_int(text: str) -> int:
+    """An integer >= 1."""
+    return _int_at_least(text, 1)
+
+
+def nonnegative_int(text: str) -> int:
+    """An integer >= 0."""
+    return _int_at_least(text, 0)
 
 
 def name_value(text: str) -> tuple[str, str]:
@@ -198,31 +228,53 @@ def _probe_writable(directory: Path) -> str | None:
 
 
 def _check_file(o: Output) -> Path:
-    p = Path(o.value).expanduser()
+    """What :func:`hunting._atomic.output_target` will write, checked now: a regular file (or a
+    link to one) in an existing, writable directory, or a writable FIFO or character device."""
+    p = Path(o.value)
     where = f"{o.flag} {o.value!r}"
-    if p.is_dir():
-        raise UsageError(f"{where} is a directory (allowed: a file path)")
-    parent = p.parent
-    if not parent.exists():
-        raise UsageError(f"{where}: directory '{parent}' does not exist (allowed: a file in an existing, "
-                         "writable directory)")
-    if not parent.is_dir():
-        raise UsageError(f"{where}: '{parent}' is not a directory (allowed: a file in an existing, "
-                         "writable directory)")
-    why = _probe_writable(parent)
-    if why:
-        raise UsageError(f"{where}: directory '{parent}' is not writable ({why})")
+    in_dir = "allowed: a file in an existing, writable directory"
+    if not p.parent.exists():
+        raise UsageError(f"{where}: directory '{p.parent}' does not exist ({in_dir})")
+    if not p.parent.is_dir():
+        raise UsageError(f"{where}: '{p.parent}' is not a directory ({in_dir})")
+    try:
+        target = output_target(p)
+    except OSError as e:
+        if e.errno == errno.ENAMETOOLONG:
+            raise UsageError(f"{where}: the name is too long (allowed: at most 255 bytes per path component)") from None
+        raise UsageError(f"{where} {e.strerror}") from None
+    if target.kind == "stream":
+        if not os.access(p, os.W_OK):
+            raise UsageError(f"{where} is not writable")
+    else:
+        parent = target.path.parent
+        if not parent.is_dir():             # only a link can lead there: p.parent exists
+            raise UsageError(f"{where} is a link to '{target.path}', whose directory does not exist ({in_dir})")
+        why = _probe_writable(parent)
+        if why:
+            raise UsageError(f"{where}: directory '{parent}' is not writable ({why})")
     if o.kind == "figure":
-        fmt = p.suffix[1:].lower()
-        formats = _figure_formats()
-        if fmt and fmt not in formats:
-            raise UsageError(f"{where}: '.{fmt}' is not a figure format (allowed suffixes: "
-                             f"{', '.join(sorted(formats))})")
+        _check_figure_format(p, where)
     return p
 
 
+def _check_figure_format(p: Path, where: str) -> None:
+    """A suffix matplotlib writes, and for .pgf the TeX program its backend runs."""
+    fmt = p.suffix[1:].lower()
+    formats = _figure_formats()
+    if fmt and fmt not in formats:
+        raise UsageError(f"{where}: '.{fmt}' is not a figure format (allowed suffixes: "
+                         f"{', '.join(sorted(formats))})")
+    if fmt == "pgf":
+        import matplotlib
+        tex = matplotlib.rcParams["pgf.texsystem"]
+        if shutil.which(tex) is None:
+            raise UsageError(f"{where}: writing .pgf needs the TeX program '{tex}', which is not installed "
+                             "(allowed here: " + ", ".join(f".{f}" for f in sorted(formats) if f != "pgf") + ")")
+
+
 def _check_dir(o: Output) -> Path:
-    p = Path(o.value).expanduser()
+    p = Path(o.value)
     where = f"{o.flag} {o.value!r}"
     if p.exists() and not p.is_dir():
         raise UsageError(f"{where} exists and is not a directory (allowed: a directory, created when missing)")
@@ -238,7 +290,7 @@ def _check_dir(o: Output) -> Path:
 
 
 def _check_input(i: Input) -> Path:
-    p = Path(i.value).expanduser()
+    p = Path(i.value)
     if not p.exists():
         raise UsageError(f"{i.flag} {i.value!r} does not exist (allowed: a readable file)")
     if not p.is_file():
@@ -248,13 +300,22 @@ def _check_input(i: Input) -> Path:
     return p
 
 
+def _is_char_device(p) -> bool:
+    try:
+        return stat.S_ISCHR(os.stat(p).st_mode)
+    except OSError:
+        return False
+
+
 def check_files(outputs, inputs=()) -> None:
     """Validate every output and input path before computing.
 
-    Outputs: "-" only where standard output is allowed (and once); files in an existing,
-    writable directory and not a directory themselves; figures with a known format; directories
-    created now (so a failure shows before the computation, not after it); all outputs distinct
-    from each other and from the inputs. Inputs: readable files."""
+    Outputs: "-" only where standard output is allowed; standard output ("-", /dev/stdout)
+    once; files in an existing, writable directory (a symbolic link: its target's), or a
+    writable FIFO or character device, never a directory, block device or socket; figures with
+    a known format; directories created now (so a failure shows before the computation, not
+    after it); all outputs distinct from each other and from the inputs (a character device
+    such as /dev/null may repeat). Inputs: readable files."""
     seen: dict = {}
     stdout_by = None
     for i in inputs:
@@ -263,29 +324,63 @@ def check_files(outputs, inputs=()) -> None:
     for o in outputs:
         if o.value is None:
             continue
-        if o.value == "-":
-            if not o.stdout:
-                raise UsageError(f"{o.flag} '-': standard output is not allowed here (allowed: a path)")
+        if o.value == "-" and not o.stdout:
+            raise UsageError(f"{o.flag} '-': standard output is not allowed here (allowed: a path)")
+        if names_stdout(o.value):
             if stdout_by is not None:
-                raise UsageError(f"{o.flag} '-': standard output is already used by {stdout_by}")
-            stdout_by = o.flag
-            continue
+                raise UsageError(f"{o.flag} {o.value!r}: standard output is already used by {stdout_by}")
+            stdout_by = f"{o.flag} {o.value!r}"
+            if o.value == "-":
+                continue
         p = _check_dir(o) if o.kind == "dir" else _check_file(o)
         key = os.path.realpath(p)
+        if _is_char_device(p):          # /dev/null twice discards both
+            continue
         if key in seen:
             raise UsageError(f"{o.flag} {o.value!r} is the same path as {seen[key]} (allowed: a different path "
                              "for every output, none of them an input)")
         seen[key] = f"{o.flag} {o.value!r}"
 
 
+def add_result_arguments(p, json_help: str, plot_help: str) -> None:
+    """--json FILE ('-': standard output) and --plot FILE, the results most commands write."""
+    p.add_argument("--json", metavar="FILE", help=f"{json_help} as JSON ('-': standard output)")
+    p.add_argument("--plot", metavar="FILE", help=f"{plot_help} (png, pdf, svg, ...)")
+
+
+def result_files(args):
+    """The outputs of :func:`add_result_arguments` (for a command's ``files``), and the model
+    file of ``--model`` (an input) when the command has one."""
+    inputs = [Input("--model", args.model)] if getattr(args, "model", None) else []
+    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], inputs
+
+
+def names_stdout(value) -> bool:
+    """Whether an output value means this process' standard output: "-", or a path that is the
+    same pipe or file (``/dev/stdout``, ``/dev/fd/1``, a file stdout is redirected to). A
+    character device is not: ``--json /dev/null`` stays a device written directly, even when
+    stdout is /dev/null too (a terminal takes both alike)."""
+    if value == "-":
+        return True
+    if value is None:
+        return False
+    try:
+        st = os.stat(value)
+        return not stat.S_ISCHR(st.st_mode) and os.path.samestat(st, os.fstat(1))
+    except (OSError, ValueError):
+        return False
+
+
 class Results:
-    """Where a command's results go: files replaced atomically, "-" to standard output."""
+    """Where a command's results go: "-" (or a path that is standard output itself) to standard
+    output, any other path through :func:`hunting._atomic.atomic_path` (regular files replaced
+    whole, devices and FIFOs written directly)."""
 
     def __init__(self, stdout):
         self._stdout = stdout
 
     def write_text(self, target: str, text: str) -> None:
-        if target == "-":
+        if names_stdout(target):
             self._stdout.write(text if text.endswith("\n") else text + "\n")
             self._stdout.flush()
             return

@@ -1,7 +1,13 @@
 """``hunting eventmap``: the stick-to-stick map P^k on a grid and its fixed points."""
 from __future__ import annotations
 
-from .boundary import Output, grid, positive_int
+import sys
+from collections import Counter
+
+import numpy as np
+
+from .advice import tell
+from .boundary import add_result_arguments, grid, positive_int, result_files
 from .systems import add_system_arguments, resolve_system
 
 NAME = "eventmap"
@@ -14,34 +20,45 @@ def add_arguments(p) -> None:
                    help="stick errors d: N points from START to STOP (e.g. 0:0.5:501)")
     p.add_argument("--iterate", type=positive_int, default=1, metavar="K",
                    help="stick phases per map application (P^K; default 1)")
-    p.add_argument("--json", metavar="FILE", help="map, statuses and fixed points as JSON ('-': standard output)")
-    p.add_argument("--plot", metavar="FILE", help="the map with its fixed points (png, pdf, svg, ...)")
+    add_result_arguments(p, "map, statuses and fixed points", "the map with its fixed points")
 
 
-def files(args):
-    return [Output("--json", args.json, stdout=True), Output("--plot", args.plot, "figure")], []
+files = result_files
 
 
 def run(args, results) -> int:
     from ..errors import Status
-    from ..eventmap import event_map, fixed_points
+    from ..eventmap import check_resolution, event_map, fixed_points, stick_family
     from ..plotting import plot_event_map
     choice = resolve_system(args)
-    loop = choice.loop
-    loop.require_stick_map()
+    if choice.model is not None:
+        loop = stick_family(choice.model)   # one Switch contact whose stick states form a 1-parameter family
+    else:
+        loop = choice.loop
+        loop.require_stick_map()
     em = event_map(loop, args.grid, args.iterate, derivative=False)
-    fps = fixed_points(loop, args.grid, args.iterate, emap=em)
-    for f in fps:
+    res = check_resolution(em, fixed_points(loop, args.grid, args.iterate, emap=em))   # logs its warnings
+    for f in res.fixed:
+        note = "  (not bracketed by the grid: found by refining)" if f in res.unbracketed else ""
         print(f"{f.kind:<12} d = {f.d:+.10f}  stick phases {f.iterate}  slope {f.slope:+.6g}  "
-              f"{'stable' if f.stable else 'unstable'}")
+              f"{'stable' if f.stable else 'unstable'}{note}")
     if args.json:
         results.write_json(args.json, {
-            "preset": args.preset, "set": choice.overrides, "iterate": args.iterate,
-            "warnings": list(choice.warnings), "grid": em.grid.tolist(),
+            "preset": args.preset, "model": getattr(args, "model", None), "set": choice.overrides,
+            "iterate": args.iterate, "warnings": list(choice.warnings) + list(res.warnings),
+            "suggested_grid": res.suggestion_text() or None, "grid": em.grid.tolist(),
             "image": [None if not ok else float(v) for v, ok in zip(em.image, em.ok)],
             "status": [Status(int(s)).name for s in em.status],
-            "fixed_points": [dict(d=f.d, iterate=f.iterate, slope=f.slope, stable=bool(f.stable), kind=f.kind,
-                                  orbit=[float(o) for o in f.orbit]) for f in fps]}, indent=1)
+            "fixed_points": [f.as_dict() | {"bracketed_by_grid": f not in res.unbracketed} for f in res.fixed],
+            "jumps": res.jumps}, indent=1, default=float)
+    defined = int(np.count_nonzero(em.ok))
+    if defined < 2:                     # one point (d = 0, say) is not a map: nothing was learnt
+        failed = Counter(Status(int(s)).name for s, ok in zip(em.status, em.ok) if not ok)
+        why = ", ".join(f"{name} at {k}" for name, k in failed.most_common())
+        print(tell(args, f"hunting: no map: P^{args.iterate} is defined at {defined} of {len(em.grid)} grid points "
+                         f"({why}): lower --iterate, or choose a grid where the motion reaches a stick phase "
+                         f"{args.iterate} times"), file=sys.stderr)
+        return 1
     if args.plot:
-        plot_event_map(em, fixed=fps, title=f"{choice.label}: P^{args.iterate}", path=args.plot)
+        plot_event_map(em, fixed=res.fixed, title=f"{choice.label}: P^{args.iterate}", path=args.plot)
     return 0

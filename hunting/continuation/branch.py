@@ -22,11 +22,12 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import Status, SystemDefinitionError
+from ..errors import SystemDefinitionError
 from ..results import SpecialPoint
 from ..system import PiecewiseSystem
 from .flow import Flow, flow
 from .shooting import PeriodicOrbit, ShootingOptions, floquet, orbit_amplitude
+from .status import OrbitStatus
 
 
 @dataclass(frozen=True)
@@ -87,7 +88,9 @@ class Branch:
 
     param : name; mu : (m,) parameter values; period : (m,); amplitude : (m,) max |x1|;
     multipliers : (m, n) complex (trivial first); stable : (m,) bool; x0 : (m, n);
-    modes : list of mode sequences; special : list of SpecialPoint; status, message."""
+    modes : list of mode sequences; special : list of SpecialPoint; status : OrbitStatus
+    (SUCCESS: the run ended where asked; POINT_LIMIT, STEP_LIMIT, NO_START, INTEGRATION_FAILED);
+    message : what happened and what to change; label; state_names : names of the x0 columns."""
 
     param: str
     mu: np.ndarray
@@ -98,14 +101,18 @@ class Branch:
     x0: np.ndarray
     modes: list
     special: list
-    status: Status
+    status: OrbitStatus
     message: str
     label: str = ""
+    state_names: tuple = ()
 
     def as_dict(self) -> dict:
+        names = self.state_names or tuple(f"x{i + 1}" for i in range(self.x0.shape[1] if self.x0.ndim == 2 else 0))
         pts = [dict(param=float(m), period=float(T), amplitude=float(a),
-                    multipliers=[[float(z.real), float(z.imag)] for z in lam], stable=bool(s))
-               for m, T, a, lam, s in zip(self.mu, self.period, self.amplitude, self.multipliers, self.stable)]
+                    multipliers=[[float(z.real), float(z.imag)] for z in lam], stable=bool(s),
+                    x0={k: float(v) for k, v in zip(names, x)})
+               for m, T, a, lam, s, x in zip(self.mu, self.period, self.amplitude, self.multipliers, self.stable,
+                                             self.x0)]
         return dict(param=self.param, label=self.label, status=self.status.name, message=self.message,
                     points=pts, special_points=[s.as_dict() for s in self.special])
 
@@ -129,21 +136,45 @@ def _nontrivial_near(lam, target):
 
 
 def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: PeriodicOrbit, mu0: float,
-                   mu_end: float, *, param: str = "mu", section: int = 0,
+                   mu_end: float, *, param: str = "mu", section: int | None = None,
                    options: ContinuationOptions | None = None, shooting: ShootingOptions | None = None,
                    stop_at_mu: float | None = None, max_turns: int = 1,
-                   amplitude: Callable[[PiecewiseSystem, np.ndarray, float, Flow], float] | None = None) -> Branch:
+                   amplitude: Callable[[PiecewiseSystem, np.ndarray, float, Flow], float] | None = None,
+                   param_direction: Callable[[float], np.ndarray] | None = None) -> Branch:
     """Follow the branch through ``orbit`` (at parameter mu0) towards mu_end.
 
-    system_at(mu) returns the system at parameter mu (its compiled functions are shared, only the
-    parameters change). The run stops when mu leaves [min(mu0, mu_end), max(mu0, mu_end)],
-    after ``max_turns`` folds once mu passes ``stop_at_mu`` (if given) on the way back, at
-    max_points, or when the step falls below ds_min. ``amplitude(system, x0, T, flow)`` gives
-    each point's amplitude from its converged flow (default: max |x1| of a simulation sampled
-    at 4001 points and at the events, :func:`orbit_amplitude`)."""
+    Parameters
+    ----------
+    system_at : callable mu -> PiecewiseSystem
+        The system at parameter mu (its compiled functions shared, only the parameters change):
+        ``ParameterLens.system_at``; :func:`follow` builds it from a parameter name.
+    orbit : PeriodicOrbit at mu0 (converged)
+    mu0, mu_end : float
+        Start and end of the parameter range (mu0 != mu_end).
+    param : name for the result; section : the state held fixed by the phase condition
+        (default: the orbit's own, where its shooting held it)
+    options, shooting : ContinuationOptions, ShootingOptions
+    stop_at_mu, max_turns : after ``max_turns`` folds the run stops once mu passes stop_at_mu
+    amplitude : callable (system, x0, T, flow) -> float, optional
+        Each point's amplitude from its converged flow (default: max |x1| of a simulation
+        sampled at 4001 points and at the events, :func:`orbit_amplitude`).
+    param_direction : callable mu -> (n_params,) d params / d mu, optional
+        Default: central differences of ``system_at``.
+
+    Returns
+    -------
+    Branch
+        Ends when mu leaves [min(mu0, mu_end), max(mu0, mu_end)] (SUCCESS), after the folds
+        (SUCCESS), at max_points (POINT_LIMIT) or when the corrector fails at ds_min
+        (STEP_LIMIT).
+    """
+    if not (np.isfinite(mu0) and np.isfinite(mu_end)) or mu0 == mu_end:
+        raise SystemDefinitionError(f"mu0 = {mu0!r} and mu_end = {mu_end!r} are not allowed: the parameter range "
+                                    f"must have two different finite ends")
     opt = options or ContinuationOptions()
     sopt = shooting or ShootingOptions()
     n = len(orbit.x0)
+    section = orbit.section if section is None else int(section)
     free = [i for i in range(n) if i != section]
     c_sec = float(orbit.x0[section])
     scale = np.concatenate([np.maximum(np.abs(orbit.x0[free]), 1e-3 * np.max(np.abs(orbit.x0))),
@@ -169,11 +200,12 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         x[free] = u[:-2]
         return x, u[-2], u[-1]
 
-    def param_direction(mu):
+    def fd_direction(mu):
         """d params / d mu at mu (central differences of system_at: exact for the usual
         parameters, which enter the array linearly)."""
         h = opt.dmu * max(abs(mu), 1e-3)
         return (system_at(mu + h).params - system_at(mu - h).params) / (2 * h)
+    direction = param_direction or fd_direction
 
     def residual_and_jac(v, need_jac=True, method=None):
         """(r, J, flow) at v; J = [Phi - I without the section column | f | d phi / d mu],
@@ -184,7 +216,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             return None                  # a diverging corrector: the caller halves the step
         sys_ = system_at(mu)
         if need_jac:
-            fl = flow(sys_, x, T, param_direction=param_direction(mu), **(kw_jac if method is None
+            fl = flow(sys_, x, T, param_direction=direction(mu), **(kw_jac if method is None
                                                                           else dict(kw_jac, method=method)))
         else:
             fl = flow(sys_, x, T, sensitivity=False, **kw_res)
@@ -289,7 +321,11 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     v = np.concatenate([orbit.x0[free], [orbit.period, mu0]]) / scale
     out = residual_and_jac(v)
     if out is None:
-        raise SystemDefinitionError("the starting orbit could not be integrated")
+        n_par = len(system_at(mu0).params)
+        return Branch(param, np.empty(0), np.empty(0), np.empty(0), np.empty((0, n), dtype=complex),
+                      np.empty(0, dtype=bool), np.empty((0, n)), [], [], OrbitStatus.INTEGRATION_FAILED,
+                      f"the starting orbit at {param} = {mu0:.6g} could not be integrated with its sensitivities "
+                      f"({n_par} parameters): check the orbit and the shooting options")
     r, J, fl = out
     t = tangent(J)
     if np.sign(t[-1]) != np.sign(mu_end - mu0):
@@ -298,11 +334,12 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     J_prev = None
     special: list[SpecialPoint] = []
     ds = opt.ds
-    status, message = Status.SUCCESS, "reached the end of the parameter range"
+    status, message = OrbitStatus.SUCCESS, "reached the end of the parameter range"
     turns = 0
     while True:
         if len(pts_v) >= opt.max_points:
-            status, message = Status.MAX_STEPS, f"max_points = {opt.max_points} reached"
+            status, message = OrbitStatus.POINT_LIMIT, (f"max_points = {opt.max_points} reached at {param} = "
+                                                        f"{unpack(v)[2]:.6g}: raise max_points or ds_max")
             break
         v_pred = v + ds * t
         if len(pts_v) >= 2 and opt.quadratic_predictor:
@@ -324,8 +361,9 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         if res is None:
             ds *= 0.5
             if ds < opt.ds_min:
-                status, message = Status.NEWTON_FAILED, (f"corrector failed at step ds < ds_min = {opt.ds_min:g} "
-                                                         f"near {param} = {unpack(v)[2]:.6g}")
+                status, message = OrbitStatus.STEP_LIMIT, (f"the corrector failed at step ds < ds_min = {opt.ds_min:g} "
+                                                           f"near {param} = {unpack(v)[2]:.6g}: "
+                                                           + OrbitStatus.STEP_LIMIT.advice)
                 break
             continue
         v_new, J_new, fl_new, refreshes = res
@@ -397,7 +435,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
                 special.append(SpecialPoint(kind, i, float(est), (lo_mu, hi_mu), hi_mu - lo_mu, data))
     special.sort(key=lambda s: s.index)
     return Branch(param, np.array(mus), np.array(Ts), np.array(amps), lams, np.array(stab), np.array(xs), modes,
-                  special, status, message)
+                  special, status, message, state_names=tuple(system_at(mu0).state_names))
 
 
 def _refine_fold(correct, tangent, unpack, v0, t0, ds, opt, index):

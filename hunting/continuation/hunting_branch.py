@@ -1,4 +1,4 @@
-"""Start and follow the hunting branch of a servo preset in one parameter."""
+"""Follow a cycle of any system in one parameter, named: :func:`follow`."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -7,16 +7,12 @@ import numpy as np
 
 from ..errors import ConvergenceError, SystemDefinitionError
 from ..models import servo as S
-from ..models.presets import PRESETS, preset
 from .branch import Branch, ContinuationOptions, continue_orbit
-from .shooting import PeriodicOrbit, ShootingOptions, cycle_guess, guess_from_stick_error, shoot
-
-
-def _stick_twin(name: str, overrides: dict):
-    """The exact-Switch version of a preset (same parameters), for event-map guesses."""
-    ov = dict(overrides)
-    ov["model"] = "switch"
-    return preset(name, **ov)
+from .cycle import find_cycle
+from .shooting import PeriodicOrbit, ShootingOptions
+from .status import OrbitStatus
+from .target import resolve
+from .transient import StartOptions
 
 
 def servo_amplitude(system, x0, T, fl) -> float:
@@ -29,57 +25,81 @@ def servo_amplitude(system, x0, T, fl) -> float:
     return float(a)
 
 
-def find_cycle(name: str, overrides: dict | None = None, *, which: str = "stable", d_max: float = 0.05,
-               shooting: ShootingOptions | None = None) -> PeriodicOrbit:
-    """A hunting cycle of ``preset(name, **overrides)``: the event map of the loop's Switch twin
-    gives the stick error of the stable (or unstable) cycle, a short simulation from its
-    break-away state the shooting guess (for LuGre the bristle state starts at its
-    steady-state value), and shooting converges on the loop's own cycle."""
-    from ..eventmap import fixed_points
-    overrides = dict(overrides or {})
-    loop = preset(name, **overrides)
-    twin = _stick_twin(name, overrides)
-    fps = [f for f in fixed_points(twin, np.linspace(0.0, d_max, 801), 2) if f.kind == "cycle"]
-    cand = [f for f in fps if f.stable == (which == "stable")]
-    if not cand:
-        raise ConvergenceError(f"{loop.name}: the event map of the Switch twin has no {which} cycle "
-                               f"on [0, {d_max}]; cycles found: {[(f.d, f.stable) for f in fps]}")
-    f = max(cand, key=lambda c: c.d) if which == "stable" else min(cand, key=lambda c: c.d)
-    x0, T = guess_from_stick_error(twin, f.d)
-    if loop.n_states == 4:
-        c = loop.friction.curve.positive
-        g = float(c.level(x0[1])) if x0[1] != 0 else c.Fs
-        x0 = np.append(x0, g / loop.friction.sigma0)
-    po = shoot(loop.system, x0, T, options=shooting)
-    if not po.success:
-        # fall back on a long simulation from the stick state
-        xg, Tg = cycle_guess(loop.system, loop.state(x1=f.d), t_settle=20 * T)
-        po = shoot(loop.system, xg, Tg, options=shooting)
-    if not po.success:
-        raise ConvergenceError(f"{loop.name}: no {which} hunting cycle found: {po.message}", po)
-    return po
+def _empty_branch(param, n, status, message, label, names) -> Branch:
+    return Branch(param, np.empty(0), np.empty(0), np.empty(0), np.empty((0, n), dtype=complex),
+                  np.empty(0, dtype=bool), np.empty((0, n)), [], [], status, message, label, names)
 
 
-def follow(name: str, param: str, start: float, end: float, *, overrides: dict | None = None,
-           stop_at: float | None = None, options: ContinuationOptions | None = None,
-           shooting: ShootingOptions | None = None, orbit: PeriodicOrbit | None = None) -> Branch:
-    """The hunting branch of a preset from ``param = start`` towards ``end``; after a fold the
-    branch is followed back until ``param`` reaches ``stop_at`` (default: ``start``). ``orbit``:
-    the cycle at ``start`` when already known (else find_cycle finds the stable one)."""
-    if name not in PRESETS:
-        raise SystemDefinitionError(f"preset = {name!r} is not known: presets are {sorted(PRESETS)}")
-    overrides = dict(overrides or {})
-    po = orbit if orbit is not None else find_cycle(name, {**overrides, param: start}, shooting=shooting)
-    loop = preset(name, **{**overrides, param: start})
-    base = loop.system
+def follow(system, param: str, start: float, end: float, *, params: dict | None = None, x0=None,
+           period_guess: float | None = None, stop_at: float | None = None,
+           options: ContinuationOptions | None = None, shooting: ShootingOptions | None = None,
+           start_options: StartOptions | None = None, orbit: PeriodicOrbit | None = None,
+           throw: bool = False) -> Branch:
+    """The branch of periodic orbits of ``system`` in the parameter called ``param``.
+
+    Parameters
+    ----------
+    system : str or ServoLoop or compiled model or PiecewiseSystem
+        What :func:`find_cycle` accepts.
+    param : str
+        The parameter's name (a preset parameter such as ``"K"`` or ``"P"``, or a system/model
+        parameter); no hand-written ``system_at`` is needed.
+    start, end : float
+        The parameter range (different, finite).
+    params : mapping name -> value, optional
+        Other parameter overrides (must not contain ``param``).
+    x0, period_guess : the start of the cycle search at ``start`` (see :func:`find_cycle`)
+    stop_at : float, optional
+        After a fold the branch is followed back until ``param`` reaches this (default: start).
+    options, shooting, start_options : ContinuationOptions, ShootingOptions, StartOptions
+    orbit : PeriodicOrbit, optional
+        The cycle at ``start`` when already known.
+    throw : raise ConvergenceError when no cycle is found at ``start``
+
+    Returns
+    -------
+    Branch
+        status NO_START (and no points) when no cycle was found at ``start``.
+
+    Examples
+    --------
+    >>> from hunting import follow
+    >>> br = follow("table8.1-switch", "K", 0.30, 0.31)
+    >>> br.status.name, len(br.mu) >= 2, bool(br.stable.all())
+    ('SUCCESS', True, True)
+    """
+    for name, v in (("start", start), ("end", end)):
+        if not isinstance(v, (int, float, np.floating)) or not np.isfinite(v):
+            raise SystemDefinitionError(f"{name} = {v!r} is not allowed: it must be a finite number")
+    if start == end:
+        raise SystemDefinitionError(f"start = end = {start!r}: the parameter range is empty; give the start "
+                                    f"(--from) and the end (--to) of the range different values")
+    params = dict(params or {})
+    if param in params:
+        raise SystemDefinitionError(f"param = {param!r} is also given in params: remove it there")
+    target = resolve(system, params)
+    lens = target.lens(param)                      # checks the name before any computation
+    at_start = resolve(system, {**params, param: start})
+    n = at_start.system.n_states
+    label = target.label
+    if orbit is None:
+        res = find_cycle(system, x0, period_guess, {**params, param: start}, shooting=shooting, start=start_options)
+        if not res.success:
+            msg = f"no cycle at {param} = {start:g}: {res.message}"
+            if throw:
+                raise ConvergenceError(msg, res)
+            return _empty_branch(param, n, OrbitStatus.NO_START, msg, label, at_start.state_names)
+        orbit = res.orbit
     opt = options or ContinuationOptions()
-    if opt.jacobian_method is None and loop.model_code == S.MODEL_LUGRE:
-        opt = replace(opt, jacobian_method="radau")       # the stiff loop's sensitivities: implicit
-
-    def system_at(mu):
-        return base.with_param_array(preset(name, **{**overrides, param: mu}).param_array())
-    br = continue_orbit(system_at, po, start, end, param=param, options=opt, shooting=shooting,
+    loop = at_start.loop
+    contacts = getattr(at_start.source, "contacts", None) or ()
+    lugre = ((loop is not None and loop.model_code == S.MODEL_LUGRE)
+             or any(getattr(c, "model", None) == "lugre" for c in contacts))
+    if opt.jacobian_method is None and lugre:
+        opt = replace(opt, jacobian_method="radau")       # stiff LuGre bristles: implicit sensitivities
+    exact_servo = loop is not None and loop.model_code != S.MODEL_BANDED
+    br = continue_orbit(lens.system_at, orbit, start, end, param=param, options=opt, shooting=shooting,
                         stop_at_mu=start if stop_at is None else stop_at,
-                        amplitude=None if loop.model_code == S.MODEL_BANDED else servo_amplitude)
-    return Branch(br.param, br.mu, br.period, br.amplitude, br.multipliers, br.stable, br.x0, br.modes,
-                  br.special, br.status, br.message, label=f"{name} {overrides}" if overrides else name)
+                        amplitude=servo_amplitude if exact_servo else None,
+                        param_direction=lens.direction)
+    return replace(br, label=label)

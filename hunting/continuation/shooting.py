@@ -11,10 +11,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ConvergenceError, Status, SystemDefinitionError
+from ..errors import ConvergenceError, SystemDefinitionError, status_message
 from ..integrate.simulate import simulate
 from ..system import PiecewiseSystem
 from .flow import flow
+from .status import OrbitStatus
 
 
 @dataclass(frozen=True)
@@ -48,8 +49,10 @@ class PeriodicOrbit:
     x0 : (n,) state on the section; period : T [s]; modes : the mode sequence over one period;
     event_times : (k,) within [0, T]; monodromy : (n, n); multipliers : (n,) complex, the trivial
     one first, then by decreasing modulus; trivial_error : |lambda_trivial - 1|; amplitude :
-    max |x1| over the orbit; stable : every non-trivial |lambda| < 1; status, message;
-    iterations : Newton iterations; residual : final scaled residual."""
+    max |x1| over the orbit; stable : every non-trivial |lambda| < 1; status : OrbitStatus;
+    message : what happened and, on failure, what to change; iterations : Newton iterations;
+    residual : final scaled residual; params : the flat parameter array of the orbit;
+    section : the state held fixed by the phase condition (x0[section] is on the section)."""
 
     x0: np.ndarray
     period: float
@@ -60,15 +63,16 @@ class PeriodicOrbit:
     trivial_error: float
     amplitude: float
     stable: bool
-    status: Status
+    status: OrbitStatus
     message: str
     iterations: int
     residual: float
     params: np.ndarray = field(repr=False, default=None)
+    section: int = 0
 
     @property
     def success(self) -> bool:
-        return self.status == Status.SUCCESS
+        return self.status == OrbitStatus.SUCCESS
 
     @property
     def nontrivial(self) -> np.ndarray:
@@ -101,8 +105,40 @@ def orbit_amplitude(system: PiecewiseSystem, x0, T, params=None, n: int = 4001, 
 
 def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
           options: ShootingOptions | None = None, throw: bool = False) -> PeriodicOrbit:
-    """Converge on a periodic orbit from a guess (x0, T); x0[section] stays fixed (phase
-    condition: the section x[section] = x0[section], e.g. x1 = 0 with x2 > 0)."""
+    """Converge on a periodic orbit from a guess (x0, T) by single shooting.
+
+    Parameters
+    ----------
+    system : PiecewiseSystem (autonomous)
+    x0 : (n,) guess of a state on the orbit; x0[section] stays fixed (the phase condition: the
+        section x[section] = x0[section], which the orbit must cross transversally)
+    T : float
+        Period guess [time unit of the system].
+    section : int
+        Index of the state held fixed.
+    params : flat parameter array replacing ``system.params``, optional
+    options : ShootingOptions
+    throw : raise ConvergenceError (carrying the PeriodicOrbit) when the status is not SUCCESS
+
+    Returns
+    -------
+    PeriodicOrbit
+        status is an :class:`OrbitStatus`: SUCCESS, SINGULAR_JACOBIAN, NOT_CONVERGED,
+        EQUILIBRIUM (the iteration reached a rest point, periodic for every T) or
+        INTEGRATION_FAILED (with the integrator's status and advice in the message).
+
+    Examples
+    --------
+    The hunting cycle of the chapter-8 Switch loop at K = 0.3 from a rough guess on the
+    section x1 = 0:
+
+    >>> from hunting import preset
+    >>> from hunting.continuation import shoot
+    >>> lp = preset("table8.1-switch", K=0.3)
+    >>> po = shoot(lp.system, [0.0, 0.079, -0.0166], 14.3)
+    >>> po.status.name, round(po.period, 4), po.stable
+    ('SUCCESS', 14.3081, True)
+    """
     opt = options or ShootingOptions()
     x = system.check_state(x0).copy()
     n = system.n_states
@@ -117,85 +153,73 @@ def shoot(system: PiecewiseSystem, x0, T, *, section: int = 0, params=None,
     kw = dict(params=p, method=opt.method, rtol=opt.rtol, atol=opt.atol, max_events=opt.max_events,
               max_steps=opt.max_steps)
 
-    def evaluate(xv, Tv):
-        fl = flow(system, xv, Tv, **kw)
+    def evaluate(xv, Tv, sensitivity=True):
+        fl = flow(system, xv, Tv, sensitivity=sensitivity, **kw)
         return fl, (fl.x - xv)
 
     fl, r = evaluate(x, T)
-    status, message = Status.SUCCESS, "converged"
+    status, message = OrbitStatus.SUCCESS, "converged"
     it = 0
     res = np.inf
     for it in range(1, opt.max_iter + 1):
         if not fl.ok:
-            status, message = fl.status, f"integration failed at iteration {it}: {fl.status.name}"
+            status, message = OrbitStatus.INTEGRATION_FAILED, (f"the flow failed at Newton iteration {it} with "
+                                                               f"{fl.status.name}: {status_message(fl.status)}")
             break
         res = float(np.max(np.abs(r) / scale[:n]))
         if res <= opt.tol:
             break
         A = np.column_stack([(fl.Phi - np.eye(n))[:, free], fl.f])
         try:
+            # singular in the scaled unknowns (states of very different sizes, e.g. the LuGre
+            # bristle state, must not read as singular)
+            colscale = np.append(scale[free], scale[n])
+            if np.linalg.cond(A * colscale[None, :] / scale[:n, None]) > 1e14:
+                raise np.linalg.LinAlgError
             dz = np.linalg.solve(A, -r)
         except np.linalg.LinAlgError:
-            status, message = Status.NEWTON_FAILED, "singular shooting Jacobian (is the orbit grazing a switching surface?)"
+            status, message = OrbitStatus.SINGULAR_JACOBIAN, (f"singular shooting Jacobian at iteration {it}: "
+                                                              + OrbitStatus.SINGULAR_JACOBIAN.advice)
             break
+        # the full step is tried with sensitivities (it is usually taken); shorter trial steps
+        # without them (a LuGre flow with them costs several plain ones), and the accepted
+        # one then gets its own flow with them
         lam = 1.0
         for _ in range(12):
             xn = x.copy()
             xn[free] += lam * dz[:-1]
             Tn = T + lam * dz[-1]
             if Tn > 0:
-                fln, rn = evaluate(xn, Tn)
+                fln, rn = evaluate(xn, Tn, sensitivity=lam == 1.0)
                 if fln.ok and np.max(np.abs(rn) / scale[:n]) < (1 - 0.25 * lam) * res + 1e-300:
+                    if lam != 1.0:
+                        fln, rn = evaluate(xn, Tn)
                     break
             lam *= 0.5
         else:
-            status, message = Status.NEWTON_FAILED, f"damped Newton could not reduce the residual ({res:.3g}) at iteration {it}"
+            status, message = OrbitStatus.NOT_CONVERGED, (f"damped Newton could not reduce the residual ({res:.3g}) "
+                                                          f"at iteration {it}: improve the guess (x0, T)")
             break
         x, T, fl, r = xn, Tn, fln, rn
     else:
-        status, message = Status.NEWTON_FAILED, f"no convergence in {opt.max_iter} iterations (residual {res:.3g}): improve the guess"
-    if status == Status.SUCCESS:
+        status, message = OrbitStatus.NOT_CONVERGED, (f"no convergence in {opt.max_iter} iterations (residual "
+                                                      f"{res:.3g}): improve the guess (x0, T) or raise max_iter")
+    if status == OrbitStatus.SUCCESS:
         res = float(np.max(np.abs(r) / scale[:n]))
         if res > opt.tol:
-            status, message = Status.NEWTON_FAILED, f"residual {res:.3g} above tol {opt.tol:.3g}"
+            status, message = OrbitStatus.NOT_CONVERGED, f"residual {res:.3g} above tol {opt.tol:.3g}"
         elif np.linalg.norm(fl.f) <= 1e-9 * max(np.linalg.norm(x), 1e-300) / T:
             # a rest point is periodic for every T: not a cycle
-            status, message = Status.NEWTON_FAILED, ("converged to an equilibrium (the vector field vanishes "
+            status, message = OrbitStatus.EQUILIBRIUM, ("converged to an equilibrium (the vector field vanishes "
                                                      "on the orbit): start closer to the cycle")
     mult, triv = (floquet(fl.Phi, fl.f) if fl.ok else (np.full(n, np.nan + 0j), np.nan))
-    amp = orbit_amplitude(system, x, T, p, method=opt.method) if status == Status.SUCCESS else np.nan
-    stable = bool(np.all(np.abs(mult[1:]) < 1.0)) if status == Status.SUCCESS else False
+    amp = orbit_amplitude(system, x, T, p, method=opt.method) if status == OrbitStatus.SUCCESS else np.nan
+    stable = bool(np.all(np.abs(mult[1:]) < 1.0)) if status == OrbitStatus.SUCCESS else False
     orbit = PeriodicOrbit(x, float(T), tuple(int(m) for m in fl.modes), fl.event_times, fl.Phi, mult, triv, amp,
-                          stable, status, message, it, res, p)
-    if throw and status != Status.SUCCESS:
+                          stable, status, message, it, res, p, section)
+    if throw and status != OrbitStatus.SUCCESS:
         raise ConvergenceError(f"{system.name}: shooting failed: {message}", orbit)
     return orbit
-
-
-def cycle_guess(system: PiecewiseSystem, x0, *, t_settle: float, section: int = 0, params=None,
-                method: str = "dop853", max_time: float = 1e4) -> tuple[np.ndarray, float]:
-    """A starting guess for shooting: simulate from x0 for t_settle, then find two successive
-    upward crossings of x[section] = 0 (with the velocity state x[1] > 0); returns (state at the
-    second crossing, time between them)."""
-    sys_ = system if params is None else system.with_param_array(params)
-    tr = simulate(sys_, x0, (0.0, t_settle), method=method, rtol=1e-10, atol=1e-13)
-    x = tr.x_final
-    t_end = min(max_time, 50 * t_settle + 100.0)
-    tr = simulate(sys_, x, (0.0, t_end), method=method, rtol=1e-10, atol=1e-13, t_eval=np.linspace(0, t_end, 200001))
-    s = tr.x[:, section]
-    up = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0) & (tr.x[1:, 1] > 0))
-    if up.size < 3:
-        raise ConvergenceError(f"{system.name}: no periodic crossing of x{section + 1} = 0 found after "
-                               f"t_settle = {t_settle}: the motion may settle (no hunting) — try another start", tr)
-    i, j = up[-2], up[-1]
-    # refine the crossing by linear interpolation, then re-simulate to it exactly
-    def cross(k):
-        a, b = s[k], s[k + 1]
-        return tr.t[k] + (tr.t[k + 1] - tr.t[k]) * (-a) / (b - a)
-    t1, t2 = cross(i), cross(j)
-    x1 = simulate(sys_, x, (0.0, t1), method=method, rtol=1e-10, atol=1e-13).x_final.copy()
-    x1[section] = 0.0
-    return x1, float(t2 - t1)
 
 
 def guess_from_stick_error(loop, d: float, *, section: int = 0) -> tuple[np.ndarray, float]:

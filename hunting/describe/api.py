@@ -15,6 +15,8 @@ from .description import validate
 def read_description(path) -> dict:
     """The description dict in a JSON or YAML file (by suffix; other suffixes: JSON, then YAML)."""
     p = Path(path)
+    if p.is_dir():
+        raise SystemDefinitionError(f"model file {str(p)!r} is a directory (allowed: a JSON or YAML file)")
     if not p.is_file():
         raise SystemDefinitionError(f"model file {str(p)!r} does not exist")
     text = p.read_text()
@@ -29,6 +31,24 @@ def read_description(path) -> dict:
         return _yaml(text, p)
 
 
+# YAML 1.2's floats: PyYAML reads YAML 1.1, where 1e5, 1.0e5 and 2E-3 (no dot, or an exponent
+# without a sign) are strings. Matched after YAML 1.1's own int and float forms, so 100 stays an
+# int and 1_000.5 a float; converted by the safe constructor (float(), never eval).
+_YAML12_FLOAT = r"^[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?$"
+
+
+def _yaml_loader():
+    import re
+
+    import yaml
+
+    class Loader(yaml.SafeLoader):
+        """yaml.SafeLoader that also reads YAML 1.2 floats (1e5, 1.0e5, -2E-3) as numbers."""
+
+    Loader.add_implicit_resolver("tag:yaml.org,2002:float", re.compile(_YAML12_FLOAT), list("-+0123456789."))
+    return Loader
+
+
 def _yaml(text: str, p: Path) -> dict:
     try:
         import yaml
@@ -36,7 +56,7 @@ def _yaml(text: str, p: Path) -> dict:
         raise SystemDefinitionError(f"model file {str(p)!r} is YAML: install pyyaml (pip install pyyaml) "
                                     "or write it as JSON") from None
     try:
-        return yaml.safe_load(text)
+        return yaml.load(text, Loader=_yaml_loader())       # noqa: S506 -- a SafeLoader subclass
     except yaml.YAMLError as e:
         raise SystemDefinitionError(f"model file {str(p)!r} is not valid YAML: {e}") from None
 

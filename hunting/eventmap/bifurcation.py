@@ -10,7 +10,9 @@ from scipy.optimize import minimize_scalar
 from ..errors import SystemDefinitionError
 from ..models.presets import preset
 from ..results import SpecialPoint
+from ..system import PiecewiseSystem
 from .engine import MapOptions, evaluate_map
+from .family import as_stick_map
 from .fixedpoints import fixed_points, origin_slope
 
 
@@ -57,8 +59,14 @@ class MapDiagram:
                     special_points=[s.as_dict() for s in self.special])
 
 
-def _loop_at(preset_name, overrides, param, value):
-    return preset(preset_name, **{**overrides, param: value})
+def _loop_at(system, overrides, param, value):
+    """The map's loop at param = value: a preset by name, or a compiled model / PiecewiseSystem
+    with the parameter set by name (its stick family)."""
+    if isinstance(system, str):
+        return preset(system, **{**overrides, param: value})
+    values = {**overrides, param: value}
+    changed = system.with_params(values) if isinstance(system, PiecewiseSystem) else system.with_params(**values)
+    return as_stick_map(changed)
 
 
 def _fold_margin(preset_name, overrides, param, value, lo_d, hi_d, sign, iterate, opt):
@@ -111,8 +119,10 @@ def map_diagram(preset_name: str, param: str, values, *, overrides: dict | None 
     and vanish) and changes of the equilibrium set's stability refined by bisection in the
     parameter to a relative width ``tol``.
 
-    preset_name, overrides : the loop (``hunting.preset(preset_name, **overrides, param=v)``)
-    param : the parameter to sweep (any preset parameter, e.g. "P" or "K"); values : (p,)"""
+    preset_name, overrides : the loop (``hunting.preset(preset_name, **overrides, param=v)``),
+        or a compiled model or PiecewiseSystem with one Switch contact (its parameters by name)
+    param : the parameter to sweep (any preset parameter, e.g. "P" or "K", or a model's or
+        system's parameter); values : (p,)"""
     overrides = dict(overrides or {})
     values = np.asarray(values, dtype=float)
     if values.ndim != 1 or values.size < 1 or not np.all(np.isfinite(values)):
@@ -153,5 +163,6 @@ def map_diagram(preset_name: str, param: str, values, *, overrides: dict | None 
             lo, hi = sorted((lo, hi))
             special.append(SpecialPoint("equilibrium_stability", i, 0.5 * (lo + hi), (lo, hi), hi - lo,
                                         {"stable_above": float(eb.stable)}))
-    label = f"{preset_name} " + " ".join(f"{k}={v}" for k, v in overrides.items())
+    name = preset_name if isinstance(preset_name, str) else getattr(preset_name, "name", "system")
+    label = f"{name} " + " ".join(f"{k}={v}" for k, v in overrides.items())
     return MapDiagram(param, values, fixed, special, iterate, label.strip())

@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import Status, SystemDefinitionError
 from ..integrate._batch import B_T_END, B_T_IN_STOP, run_batch
 from ..models.loop import ServoLoop
+from .family import StickFamily, as_stick_map
 
 DEFAULT_RTOL = 1e-12
 
@@ -74,7 +75,10 @@ def evaluate_map(loop: ServoLoop, d, iterate: int = 1, options: MapOptions | Non
     """P^k(d) for an array of stick errors d (true map, parallel over points).
 
     For an odd loop (symmetric friction, no cogging, no external force: ``loop.odd``) each |d|
-    is integrated once and P^k(-d) = -P^k(d) is used; otherwise every point is integrated."""
+    is integrated once and P^k(-d) = -P^k(d) is used; otherwise every point is integrated.
+    ``loop`` may also be a preset name, a compiled model or a PiecewiseSystem with one sticking
+    contact (:func:`hunting.eventmap.stick_family`)."""
+    loop = as_stick_map(loop)
     opt = options or MapOptions()
     if int(iterate) != iterate or iterate < 1:
         raise SystemDefinitionError(f"iterate = {iterate!r} is not allowed: it must be an integer >= 1")
@@ -108,7 +112,7 @@ def _evaluate(loop: ServoLoop, d: np.ndarray, iterate: int, opt: MapOptions) -> 
                                        rtol=opt.rtol, max_steps=opt.max_steps,
                                        max_events=opt.max_events, guard_tol=atol,
                                        stop_mode=loop.stick_mode, stop_count=int(iterate))
-        image[run] = Xe[:, 0]
+        image[run] = Xe[:, 0] if not isinstance(loop, StickFamily) else loop.stick_error(Xe)
         status[run] = st
         n_ev[run] = ne
         entry[run] = Xe
@@ -160,7 +164,11 @@ def event_map(loop: ServoLoop, grid, iterate: int = 1, *, derivative: bool = Tru
     iterate : k, the number of stick phases per map application
     derivative : also compute dP^k/dd by central differences of the true map with step
         h = fd_step * max(|d|, d_floor) (two more evaluations per point)
+
+    ``loop`` may also be a preset name, a compiled model or a PiecewiseSystem with one sticking
+    contact whose stick states form a one-parameter family (:func:`hunting.eventmap.stick_family`).
     """
+    loop = as_stick_map(loop)
     opt = options or MapOptions()
     grid = np.asarray(grid, dtype=float).ravel()
     mv = evaluate_map(loop, grid, iterate, opt)

@@ -2,36 +2,48 @@
 
 A fixed point d* != 0 of P^k is a hunting limit cycle with k stick phases per period (after
 reduction to the minimal k); d* = 0 is the equilibrium set, whose stability follows from the
-one-sided slopes of P^k at the origin (maps can be discontinuous there, or unbounded in slope,
-for beta <= 1 and the discontinuous curve: thesis section 9.5).
+one-sided slopes of P^k at the origin: exact from the loop's linearization where the friction
+curve has one at zero velocity (beta >= 1, Coulomb; :mod:`hunting.eventmap.origin`), from
+probes of the map otherwise (beta < 1 and the discontinuous curve: the map jumps at the
+origin, thesis section 9.5). A fixed point between the origin and the first grid point is
+bracketed with the slope at the origin, so a coarse grid does not hide it.
 """
 from __future__ import annotations
+
+import logging
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import Status
+from ..errors import Status, SystemDefinitionError
 from ..models.loop import ServoLoop
 from .engine import EventMap, MapOptions, evaluate_map, event_map
+from .family import as_stick_map
+from .origin import force_length, linear_origin
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
 class OriginSlope:
     """Behaviour of P^k near d = 0 from the right and the left.
 
-    slope_right, slope_left : P^k(delta)/delta at the smallest probe (NaN where a probe failed);
-    behaviour : "linear" (the ratios settle: P^k is linear near 0, as for beta > 1), "steep"
-    (the ratios still grow at the smallest probe: P^k(delta) shrinks more slowly than delta, a
-    slope that is unbounded or very large, beta = 1), "discontinuous" (|P^k(delta)| does not go
-    to 0: the map jumps at the origin, beta < 1 and the discontinuous curve) or "undefined" (a
-    probe failed; see its status);
-    probes : (deltas, ratios right, ratios left)."""
+    slope_right, slope_left : dP^k/dd at 0+ and 0- (method "linearization"), or P^k(delta)/delta
+    at the smallest probe (method "probes"; NaN where a probe failed);
+    behaviour : "linear" (a finite slope: from the linearization, or probe ratios that settle),
+    "steep" (unbounded: the linearized slip grows away without sticking, or the probe ratios
+    still grow at the smallest probe), "discontinuous" (|P^k(delta)| does not go to 0: the map
+    jumps at the origin, beta < 1 and the discontinuous curve) or "undefined" (a probe failed;
+    see its status);
+    probes : (deltas, ratios right, ratios left), or () when not computed;
+    method : "linearization" or "probes"."""
 
     slope_right: float
     slope_left: float
     behaviour: str
     probes: tuple
+    method: str = "probes"
 
     @property
     def stable(self) -> bool:
@@ -85,22 +97,72 @@ def _classify(deltas, images, ratios) -> str:
     return "steep" if b > a else "linear"
 
 
-def origin_slope(loop: ServoLoop, iterate: int, scale: float, options: MapOptions | None = None) -> OriginSlope:
-    """One-sided slopes of P^k at 0 from probes delta = scale * 10^-j, j = 2..7.
-
-    Smaller probes are not used: below about 1e-7 of the map's scale the break-away motion is
-    driven by a force difference that rounding errors of O(eps Fs) swamp."""
+def probe_origin(loop: ServoLoop, iterate: int, scale: float, options: MapOptions | None = None) -> tuple:
+    """(deltas, P^k(delta)/delta right, left, behaviour) from probes delta = scale * 10^-j,
+    j = 2..7. Smaller probes are not used: below about 1e-7 of the map's scale the break-away
+    motion is driven by a force difference that rounding errors of O(eps Fs) swamp."""
     deltas = scale * 10.0 ** -np.arange(2, 8)
     right = evaluate_map(loop, deltas, iterate, options)
     left = evaluate_map(loop, -deltas, iterate, options)
     rr = np.where(right.ok, right.image / deltas, np.nan)
     rl = np.where(left.ok, left.image / -deltas, np.nan)
     kinds = {_classify(deltas, right.image, rr), _classify(deltas, left.image, rl)}
-    for k in ("undefined", "discontinuous", "steep", "linear"):
-        if k in kinds:
-            behaviour = k
-            break
-    return OriginSlope(float(rr[-1]), float(rl[-1]), behaviour, (deltas, rr, rl))
+    behaviour = next(k for k in ("undefined", "discontinuous", "steep", "linear") if k in kinds)
+    return deltas, rr, rl, behaviour
+
+
+def probe_scale(loop: ServoLoop, scale: float | None) -> float:
+    """The probes' scale: the force length Fs / |cm kp + alpha| of the loop, or ``scale`` (the
+    grid's extent) when that is smaller or the loop has no proportional action."""
+    L = force_length(loop)
+    cands = [v for v in (L, scale) if v is not None and np.isfinite(v) and v > 0]
+    return min(cands) if cands else 1.0
+
+
+def origin_slope(loop: ServoLoop, iterate: int, scale: float | None = None, options: MapOptions | None = None,
+                 *, probes: bool = False) -> OriginSlope:
+    """One-sided slopes of P^k at 0: from the linearization (:func:`linear_origin`) where the
+    friction curve has one, else from probes of the map (:func:`probe_origin`) at
+    :func:`probe_scale` (``scale``: the extent of the grid, an upper bound). ``probes`` also
+    computes the probes where the linearization answers (a cross-check)."""
+    lin = linear_origin(loop, iterate)
+    if lin is not None:
+        behaviour = "linear" if np.isfinite(lin.slope_right) and np.isfinite(lin.slope_left) else "steep"
+        pr = ()
+        if probes:
+            deltas, rr, rl, _ = probe_origin(loop, iterate, probe_scale(loop, scale), options)
+            pr = (deltas, rr, rl)
+        return OriginSlope(lin.slope_right, lin.slope_left, behaviour, pr, "linearization")
+    deltas, rr, rl, behaviour = probe_origin(loop, iterate, probe_scale(loop, scale), options)
+    return OriginSlope(float(rr[-1]), float(rl[-1]), behaviour, (deltas, rr, rl), "probes")
+
+
+def _origin_brackets(loop, em: EventMap, g: np.ndarray, os_: OriginSlope, iterate: int, opt) -> list:
+    """Brackets (a, b, g(a), g(b)) of fixed points between the origin and the grid point nearest
+    to it on each side, where the slope at the origin gives g = P^k(d) - d one sign near 0 and
+    that grid point the other (the 0.00336 cycle of table 9.1 on a grid 0:0.5:11)."""
+    out = []
+    if os_.behaviour != "linear":
+        return out
+    for side, slope in ((1.0, os_.slope_right), (-1.0, os_.slope_left)):
+        expect = np.sign(slope - 1.0) * side          # sign of g(d) = (slope - 1) d for small |d| on this side
+        idx = np.flatnonzero(em.ok & (np.sign(em.grid) == side))
+        if expect == 0 or idx.size == 0:
+            continue
+        i = idx[np.argmin(np.abs(em.grid[idx]))]
+        d1, g1 = em.grid[i], g[i]
+        if np.sign(g1) != -expect:
+            continue
+        ds = d1 * 10.0 ** -np.arange(1, 8)            # towards 0 until g has the sign of the slope
+        mv = evaluate_map(loop, ds, iterate, opt)
+        gs = np.where(mv.ok, mv.image - ds, np.nan)
+        near = np.flatnonzero(np.sign(gs) == expect)
+        if near.size == 0:
+            continue
+        j = int(near[0])                               # the largest probe with the slope's sign
+        b, gb = (ds[j - 1], gs[j - 1]) if j > 0 and np.sign(gs[j - 1]) == -expect else (d1, g1)
+        out.append((ds[j], b, gs[j], gb))
+    return out
 
 
 def _refine(loop, a, b, ga, gb, iterate, opt, tol, max_iter=200):
@@ -164,6 +226,19 @@ def _thesis_fit(grid, image, i):
     return r, float(np.polyval(np.polyder(np.polyfit(xs, ys, 3)), r))
 
 
+def _grid(grid) -> np.ndarray:
+    """The stick errors of a grid: at least 2 finite numbers (fixed points are bracketed
+    between neighbours), else a SystemDefinitionError naming the grid."""
+    allowed = "at least 2 finite stick errors, e.g. np.linspace(0, 0.5, 501)"
+    try:
+        g = np.asarray(grid, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise SystemDefinitionError(f"grid = {grid!r} is not allowed: {allowed}") from None
+    if g.size < 2 or not np.all(np.isfinite(g)):
+        raise SystemDefinitionError(f"grid = {grid!r} is not allowed: {allowed}")
+    return g
+
+
 def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
                  options: MapOptions | None = None, thesis_fits: bool = False,
                  emap: EventMap | None = None) -> list[FixedPoint]:
@@ -172,24 +247,31 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
     Cycles are reported once per orbit (the largest stick error of the orbit as ``d``) with
     their minimal number of stick phases; the equilibrium set d = 0 is always reported when the
     grid spans or touches 0. ``thesis_fits`` adds the thesis' local fits for comparison."""
+    loop = as_stick_map(loop)            # a preset name, compiled model or PiecewiseSystem as well
     opt = options or MapOptions()
-    grid = np.asarray(grid, dtype=float).ravel()
+    grid = _grid(grid) if emap is None else emap.grid
     em = emap if emap is not None else event_map(loop, grid, iterate, derivative=False, options=opt)
     g = em.image - em.grid
     ok = em.ok
     i = np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(g[:-1]) * np.sign(g[1:]) < 0)
                        & (em.grid[:-1] * em.grid[1:] > 0))
-    if i.size:
-        roots, jumps = _refine(loop, em.grid[i], em.grid[i + 1], g[i], g[i + 1], iterate, opt, tol)
+    scale = max(np.max(np.abs(grid)), opt.d_floor)
+    os_ = origin_slope(loop, iterate, scale, opt) if grid.min() <= 0 <= grid.max() else None
+    extra = _origin_brackets(loop, em, g, os_, iterate, opt) if os_ is not None else []
+    lo = np.concatenate([em.grid[i], [e[0] for e in extra]])
+    hi = np.concatenate([em.grid[i + 1], [e[1] for e in extra]])
+    glo = np.concatenate([g[i], [e[2] for e in extra]])
+    ghi = np.concatenate([g[i + 1], [e[3] for e in extra]])
+    if lo.size:
+        roots, jumps = _refine(loop, lo, hi, glo, ghi, iterate, opt, tol)
     else:
         roots, jumps = np.empty(0), np.empty(0)
     exact = np.flatnonzero(ok & (g == 0) & (em.grid != 0))
     roots = np.concatenate([roots, em.grid[exact]])
     jumps = np.concatenate([jumps, np.zeros(exact.size)])
-    brackets = list(i) + [None] * exact.size
+    brackets = list(i) + [None] * (len(extra) + exact.size)
     out: list[FixedPoint] = []
     seen: list[np.ndarray] = []
-    scale = max(np.max(np.abs(grid)), opt.d_floor)
     for r, bi, jump in zip(roots, brackets, jumps):
         res = evaluate_map(loop, [r], iterate, opt)
         resid = abs(res.image[0] - r)
@@ -209,7 +291,7 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
                 k = j
                 break
         orbit = np.array(orbit[:k])
-        if any(o.size == orbit.size and np.min(np.abs(o - r)) < 1e-7 * scale for o in seen):
+        if any(o.size == orbit.size and np.min(np.abs(o - r)) < 1e-7 * max(abs(r), opt.d_floor) for o in seen):
             continue
         seen.append(orbit)
         rep = float(orbit[np.argmax(orbit)])
@@ -219,8 +301,7 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
             fit_d, fit_s = _thesis_fit(em.grid, em.image, bi)
         out.append(FixedPoint(rep, k, slope, abs(slope) < 1.0, "cycle", tuple(np.roll(orbit, -int(np.argmax(orbit)))),
                               float(resid), None, fit_d, fit_s))
-    if grid.min() <= 0 <= grid.max():
-        os_ = origin_slope(loop, iterate, scale, opt)
+    if os_ is not None:
         slope = max(os_.slope_right, os_.slope_left, key=lambda v: abs(v) if np.isfinite(v) else np.inf)
         fit_d = fit_s = None
         if thesis_fits:

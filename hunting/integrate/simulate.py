@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from ..errors import ConvergenceError, Status, SystemDefinitionError, check_finite_positive
+from ..errors import ConvergenceError, Status, SystemDefinitionError, check_finite_positive, status_message
 from ..results import EventLog, Trajectory, make_status
 from ..system import PiecewiseSystem, no_jacobian
 from . import _kernel as K
@@ -18,12 +18,61 @@ def _grow(a: np.ndarray, rows: int) -> np.ndarray:
     return new
 
 
+def _initial_state(system: PiecewiseSystem, x0) -> np.ndarray:
+    allowed = f"{system.n_states} finite numbers (states {', '.join(system.state_names)})"
+    if isinstance(x0, (str, bytes)):
+        raise SystemDefinitionError(f"x0 = {x0!r} is not allowed: x0 must be {allowed}, not a string")
+    try:
+        return system.check_state(x0)
+    except SystemDefinitionError:
+        raise
+    except (TypeError, ValueError):
+        raise SystemDefinitionError(f"x0 = {x0!r} is not allowed: x0 must be {allowed}") from None
+
+
+def _state_limits(system: PiecewiseSystem, x0: np.ndarray, growth, bounds) -> tuple:
+    """(|x_i| limits from ``bounds`` and ``growth``: an (n,) array, a number when every state
+    has the same one, None when there is nothing to check; the growth limit alone, inf without one)."""
+    g_lim = math.inf
+    if growth is not None:
+        g = check_finite_positive("growth", growth)
+        if g <= 1:
+            raise SystemDefinitionError(f"growth = {growth!r} is not allowed: it must be > 1 (None: no check)")
+        g_lim = g * max(1.0, *(abs(float(v)) for v in x0))
+    if bounds is None:
+        return (None if math.isinf(g_lim) else g_lim), g_lim
+    n = system.n_states
+    try:
+        b = np.broadcast_to(np.asarray(bounds, dtype=np.float64), (n,))
+    except (TypeError, ValueError):
+        raise SystemDefinitionError(f"bounds = {bounds!r} is not allowed: a number or {n} numbers > 0 "
+                                    f"(|x_i| limits for {list(system.state_names)}; inf: no limit)") from None
+    if np.any(np.isnan(b)) or np.any(b <= 0):
+        raise SystemDefinitionError(f"bounds = {bounds!r} is not allowed: every limit must be > 0 (inf: no limit)")
+    lim = np.minimum(b, g_lim)
+    return (lim if np.any(np.isfinite(lim)) else None), g_lim
+
+
+def _peak(a: np.ndarray) -> float:
+    """max |a| (0 for an empty array)."""
+    return float(np.abs(a).max()) if a.size else 0.0
+
+
+def _first_over(x: np.ndarray, lim) -> int:
+    """Index of the first row of x (m, n) with some |x_i| > lim_i (lim: (n,) or a number), or -1."""
+    if _peak(x) <= (lim if isinstance(lim, float) else np.min(lim)):
+        return -1
+    over = np.flatnonzero((np.abs(x) > lim).any(axis=1))
+    return int(over[0]) if over.size else -1
+
+
 def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rtol: float = 1e-10,
              atol: float = 1e-12, t_eval=None, mode0: int | str | None = None,
              first_step: float | None = None, max_step: float = math.inf,
              max_steps: int = 1_000_000, max_events: int = 100_000, guard_tol: float = 1e-12,
              fixed_step: float | None = None, stop_mode: int | str | None = None, stop_count: int = 1, zeno_count: int = 50,
-             zeno_window: float | None = None, params=None, throw: bool = False) -> Trajectory:
+             zeno_window: float | None = None, params=None, growth: float | None = 1e6, bounds=None,
+             throw: bool = False) -> Trajectory:
     """Integrate a piecewise-smooth system with exact event location.
 
     Parameters
@@ -49,6 +98,12 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     zeno_count, zeno_window : ``zeno_count`` events within ``zeno_window`` seconds (default
         1e-9 of the span) end the run with status ZENO
     params : optional flat parameter array replacing ``system.params`` for this run
+    growth : the run ends with status DIVERGED once some |x_i| exceeds growth * max(max|x0|, 1)
+        (the state's own units; None: no check). A loop made unstable by its parameters
+        otherwise runs on to 1e76 and reports SUCCESS.
+    bounds : optional |x_i| limits, a number or (n,) (inf: no limit); leaving them ends the run
+        with status OUT_OF_BOUNDS. The returned trajectory ends at the first output point beyond
+        a limit (with t_eval: the output points before it).
     throw : raise ConvergenceError (carrying the Trajectory) unless the run succeeded
 
     Returns
@@ -58,7 +113,8 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     if not isinstance(system, PiecewiseSystem):
         raise SystemDefinitionError(f"system = {system!r} is not a PiecewiseSystem "
                                     "(models build one: e.g. hunting.preset('table9.1').system)")
-    x0 = system.check_state(x0)
+    x0 = _initial_state(system, x0)
+    lim, g_lim = _state_limits(system, x0, growth, bounds)
     try:
         t0, t1 = (float(v) for v in t_span)
     except (TypeError, ValueError):
@@ -126,6 +182,7 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     nf, ni = K.workspace_sizes(n, n, system.n_guards, system.n_modes, int(zeno_count))
     wf, wi = np.empty(nf), np.empty(ni, dtype=np.int64)
     t_cur, x_cur, m_cur = t0, x0, m0
+    checked = 0                         # output rows already checked against the limits
     for _ in range(10_000):
         steps_left = int(max_steps) - int(info[K.I_NSTEPS] + info[K.I_NREJ])
         K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
@@ -136,6 +193,10 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
                            info, finfo, x_final, wf, wi)
         if info[K.I_STATUS] != Status.BUFFER_FULL:
             break
+        if lim is not None:             # stop a diverging run at the first full buffer beyond the limits
+            if _first_over(out_x[checked:int(info[K.I_NOUT])], lim) >= 0:
+                break
+            checked = int(info[K.I_NOUT])
         # grow whichever buffer is full and resume from the step boundary
         if info[K.I_NOUT] + 3 > out_t.size:
             out_t, out_x, out_m = (_grow(a, 2 * a.shape[0]) for a in (out_t, out_x, out_m))
@@ -156,6 +217,10 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
         t_out = np.append(t_out, finfo[K.F_T])
         x_out = np.vstack([x_out, x_final[None, :]])
         m_out = np.append(m_out, info[K.I_MODE])
+    if lim is not None:
+        status, message, t_out, x_out, m_out, nev = _limit_status(
+            status, message, lim, g_lim, t_out, x_out, m_out, ev_t[:nev], ev_xa[:nev], float(finfo[K.F_T]),
+            x_final, system.state_names, t_eval is None)
     events = EventLog(ev_t[:nev].copy(), ev_xb[:nev].copy(), ev_xa[:nev].copy(), ev_g[:nev].copy(),
                       ev_f[:nev].copy(), ev_to[:nev].copy())
     stats = dict(n_steps=int(info[K.I_NSTEPS]), n_rejected=int(info[K.I_NREJ]),
@@ -165,3 +230,35 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     if throw and not status.ok:
         raise ConvergenceError(f"{system.name}: {message}", traj)
     return traj
+
+
+def _limit_status(status, message, lim, g_lim, t_out, x_out, m_out, ev_t, ev_x, t_end, x_end, names, dense):
+    """Status DIVERGED / OUT_OF_BOUNDS and the trajectory cut after the first point beyond the
+    limits, when there is one; else everything unchanged. Checks the outputs, the event states
+    and the final state (with t_eval the outputs alone could step over a short excursion; without
+    it, ``dense``, every event state and the final state are outputs)."""
+    low = lim if isinstance(lim, float) else float(np.min(lim))
+    if _peak(x_out) <= low and (dense or max(_peak(ev_x), _peak(x_end)) <= low):    # the common case, quickly
+        return status, message, t_out, x_out, m_out, ev_t.size
+    candidates = []
+    j = _first_over(x_out, lim)
+    if j >= 0:
+        candidates.append((t_out[j], x_out[j]))
+    k = _first_over(ev_x, lim)
+    if k >= 0:
+        candidates.append((ev_t[k], ev_x[k]))
+    if _first_over(x_end[None, :], lim) >= 0:
+        candidates.append((t_end, x_end))
+    if not candidates:
+        return status, message, t_out, x_out, m_out, ev_t.size
+    t_bad, x_bad = min(candidates, key=lambda c: c[0])
+    lim = np.broadcast_to(lim, x_bad.shape)
+    i = int(np.argmax(np.abs(x_bad) / lim))
+    new = Status.DIVERGED if abs(x_bad[i]) > g_lim else Status.OUT_OF_BOUNDS
+    why = "growth limit: max(|x0|, 1) times growth" if new == Status.DIVERGED else "the bound given"
+    name = names[i] if i < len(names) else f"x{i + 1}"
+    text = f"at t = {t_bad:.6g}: {name} = {x_bad[i]:.4g} is beyond {lim[i]:.4g} ({why}): {status_message(new)}"
+    if not status.ok and status != Status.BUFFER_FULL:
+        text += f" (the integration itself ended with {status.name})"
+    keep = t_out <= t_bad
+    return new, text, t_out[keep], x_out[keep], m_out[keep], int(np.searchsorted(ev_t, t_bad, side="right"))

@@ -23,7 +23,7 @@ from ..experiment import limms as X
 from ..experiment.motor import F_QD, Q_D, SLOPE_QD
 from ..models import preset
 from ..models import servo as S
-from ..plotting import _plt, plot_attractor_diagram, plot_event_map, plot_frf, save
+from ..plotting import _plt, plot_attractor_diagram, plot_event_map, plot_frf, save, thesis_marks
 from .checks import Ledger
 
 K_VALUES = np.arange(10.0, 60.01, 2.0)
@@ -58,10 +58,11 @@ def _identification(L: Ledger, motor: VirtualMotor, out: Path, results: dict):
     r = idl.records
     g = 1.0 / idl.mass.values["m_over_cm"]
     P = r["P"].band(1.0, 1000.0)
-    plot_frf([(P.f, P.H, "reconstructed P = (1/S - 1)/C", "-"),
-              (P.f, g / (2j * np.pi * P.f) ** 2, f"double integrator, m/cm = {1 / g:.4f} kg V/N", "--")],
-             title="Fig. 10.4: LiMMS FRF from the closed-loop sensitivity (fit 30-140 Hz)", unit="m/V",
-             path=out / "fig10_4.png")
+    fig = plot_frf([(P.f, P.H, "reconstructed P = (1/S - 1)/C", "-"),
+                    (P.f, g / (2j * np.pi * P.f) ** 2, f"double integrator, m/cm = {1 / g:.4f} kg V/N", "--")],
+                   title="Fig. 10.4: LiMMS FRF from the closed-loop sensitivity (fit 30-140 Hz)", unit="m/V")
+    L.on_figure(fig.axes[0], [("m [kg]", "identified m [kg]", ".4g")], loc="lower left")
+    save(fig, out / "fig10_4.png")
     plt = _plt()
     rec_c, rv, cruise = r["cogging"]
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.0), sharex=True)
@@ -74,6 +75,11 @@ def _identification(L: Ledger, motor: VirtualMotor, out: Path, results: dict):
     a2.plot(qg, Ft, "-", color="0.6", lw=2.5, label="true (virtual motor)")
     a2.plot(qg, idl.cogging(qg), "-", color="k", lw=0.8, label="identified table")
     a2.axvline(Q_D, color="C2", lw=0.8, ls=":", label="q_d")
+    thesis_marks(a2, Q_D, F_QD, label=f"thesis: F_cog(q_d) = {F_QD} N")
+    dq = np.array([-0.003, 0.003])
+    a2.plot(Q_D + dq, F_QD + SLOPE_QD * dq, "--", color="C3", lw=1.2, label=f"thesis: slope {SLOPE_QD:.5g} N/m")
+    L.on_figure(a2, [("F_cog(q_d) [N]", "identified F_cog(q_d)", ".4g"),
+                     ("dF_cog/dq [N/m]", "identified dF_cog/dq(q_d)", ".4g")], loc="upper right", room=0.45)
     a2.set_xlabel("q [m]")
     a2.set_ylabel("F_cog [N]")
     a2.legend(fontsize=8)
@@ -89,6 +95,11 @@ def _identification(L: Ledger, motor: VirtualMotor, out: Path, results: dict):
     cur = idl.curve
     ax.plot(vv, cur.positive.level(vv) + cur.positive.b * vv, "-", color="C0", label="fit, per direction")
     ax.plot(-vv, -(cur.negative.level(vv) + cur.negative.b * vv), "-", color="C0")
+    ax.plot(vv, motor.positive.level(vv) + motor.positive.b * vv, "--", color="C3", lw=1.0,
+            label="thesis, Table 10.2 (the virtual motor's curve)")
+    ax.plot(-vv, -(motor.negative.level(vv) + motor.negative.b * vv), "--", color="C3", lw=1.0)
+    L.on_figure(ax, [(f"{p} ({sgn})", f"identified {p} ({sgn}) ", ".4g") for sgn in "+-" for p in ("Fs", "Fc", "vs", "b")],
+                loc="lower right")
     ax.set_xscale("symlog", linthresh=1e-3)
     ax.set_xlabel("v [m/s]")
     ax.set_ylabel("F [N]")
@@ -102,12 +113,14 @@ def _identification(L: Ledger, motor: VirtualMotor, out: Path, results: dict):
     P = r["P"].band(10.0, 1000.0)
     pv = idl.presliding.values
     s = 2j * np.pi * H.f
-    plot_frf([(H.f, H.H, f"presliding FRF at q* = {idl.q_star:.4f} m", "-"),
-              (H.f, pv["b0"] / (s ** 2 + pv["a1"] * s + pv["a0"]),
-               f"2nd order: sigma0 + alpha = {pv['a0'] * idl.m:.3g} N/m", "--"),
-              (P.f, P.H, "sliding (Fig. 10.4)", ":")],
-             title="Fig. 10.7: presliding FRF below the static friction and its fit", unit="m/V",
-             path=out / "fig10_7.png")
+    fig = plot_frf([(H.f, H.H, f"presliding FRF at q* = {idl.q_star:.4f} m", "-"),
+                    (H.f, pv["b0"] / (s ** 2 + pv["a1"] * s + pv["a0"]),
+                     f"2nd order: sigma0 + alpha = {pv['a0'] * idl.m:.3g} N/m", "--"),
+                    (P.f, P.H, "sliding (Fig. 10.4)", ":")],
+                   title="Fig. 10.7: presliding FRF below the static friction and its fit", unit="m/V")
+    L.on_figure(fig.axes[0], [("sigma0 [N/m]", "identified sigma0 [N/m]", ".3g"),
+                              ("sigma1 [N s/m]", "identified sigma1 [N s/m]", ".3g")], loc="lower left")
+    save(fig, out / "fig10_7.png")
     return idl
 
 
@@ -241,6 +254,7 @@ def _event_maps(L: Ledger, motor: VirtualMotor, idl, out: Path, results: dict):
         plot_event_map(emk, ax=a2, title=f"Fig. 10.11b: P^{k}; its contracting fixed points are the cycle")
         for d in main.d:
             a2.axvline(d, color="C3", ls="--", lw=0.8)
+    L.on_figure(a1, [("stick phases per period", "stick phases per period of the model's main cycle at K = 10", ".0f")])
     fig.tight_layout()
     save(fig, out / "fig10_11.png")
 
@@ -287,8 +301,6 @@ def _diagrams(L: Ledger, motor: VirtualMotor, idl, out: Path, results: dict, K_v
                            title="Fig. 10.12a: virtual LiMMS (simulated measurement)")
     plot_attractor_diagram(K_values, model, ax=a2, unit="mm", scale=1e3, param="K [V/m]",
                            title="Fig. 10.12b: identified Switch model (event maps)")
-    fig.tight_layout()
-    save(fig, out / "fig10_12.png")
 
     def gone(kinds):
         """Midway between the last gain with hunting and the next gain of the grid."""
@@ -312,6 +324,16 @@ def _diagrams(L: Ledger, motor: VirtualMotor, idl, out: Path, results: dict, K_v
     n_hi = [max((a.period for a in atts if a.kind == "cycle"), default=0) for K, atts in zip(K_values, model) if K >= 40]
     L.fact("model: fewer stick phases per period as K grows (K = 10 vs K >= 40)", bool(n10 > max(n_hi)), True)
     L.number("virtual LiMMS: hunting gone above K (thesis' machine: about 42)", K_gone_meas, 42.0, 8.0, "V/m")
+    a1.axvline(42.0, color="C3", ls="--", lw=1.0, label="thesis' machine: hunting gone above about 42")
+    a2.axvline(54.0, color="C3", ls="--", lw=1.0, label="thesis' model: cycles gone above about 54")
+    a2.axvline(50.0, color="C3", ls=":", lw=1.0, label="thesis' model: equilibrium set attracts from about 50")
+    for a in (a1, a2):
+        a.legend(fontsize=7, loc="upper right")
+    L.on_figure(a1, [("hunting gone above K", "virtual LiMMS: hunting gone above K", ".3g")], loc="lower right")
+    L.on_figure(a2, [("cycles gone above K", "model: hunting cycles gone above K", ".3g"),
+                     ("eq. set attracts from K", "model: equilibrium set attracts from K", ".3g")], loc="lower right")
+    fig.tight_layout()
+    save(fig, out / "fig10_12.png")
     results["K_gone"] = dict(model=K_gone_model, measured=K_gone_meas)
 
 

@@ -40,6 +40,20 @@ def _orbit_at(name, branch, mu, stable):
     return shoot(lp.system, branch.x0[i], branch.period[i])
 
 
+def _thesis_fold(L: Ledger, ax, ax_table, short: str, fold_thesis: float) -> None:
+    """The thesis' fold as a red dashed line beside ours, and the fold check as a table on
+    ``ax_table`` (the multipliers' panel, where it covers nothing)."""
+    ax.axvline(fold_thesis, color="C3", ls="--", lw=1.0, label=f"thesis: cyclic fold K = {fold_thesis}")
+    for inset in ax.child_axes:             # the magnified view of the fold: above the line, with its own
+        inset.set_zorder(10)
+        inset.patch.set_facecolor("white")
+        inset.axvline(fold_thesis, color="C3", ls="--", lw=1.0)
+    ax.legend(fontsize=8, loc="upper left")
+    items = [("fold K", f"{short}: fold K (within 0.5 %)", ".4f")] if any(
+        r["check"] == f"{short}: fold K (within 0.5 %)" for r in L.rows) else []
+    L.on_figure(ax_table, items + [("one cyclic fold", f"{short}: one cyclic fold", "")], loc="upper right")
+
+
 def run(out: Path) -> int:
     out.mkdir(parents=True, exist_ok=True)
     L = Ledger("Chapter 8")
@@ -73,15 +87,19 @@ def run(out: Path) -> int:
     L.fact("sufficient condition sigma2 / J > pi", bool(lg.friction.sigma2 / lg.plant.mass > math.pi), True)
 
     print("Fig. 8.2 -- regulator task theta_d = 1 rad, K = 0.04: both loops hunt")
-    amps = {}
+    amps, figs = {}, {}
     for name, method in (("table8.1-switch", "dop853"), ("table8.1-lugre", "dop853")):
         lp = preset(name, K=0.04)
         tr = simulate(lp.system, lp.state(x1=-1.0), (0.0, 100.0), method=method, rtol=1e-9, atol=1e-12, throw=True)
         amps[name] = float(np.max(np.abs(tr.x[tr.t > 70, 0])))
-        plot_trajectory(tr, title=f"Fig. 8.2: {name}, K = 0.04", units=lp.system.units,
-                        stick_modes=[lp.stick_mode] if lp.stick_mode is not None else [],
-                        path=out / f"fig8_2_{name.split('-')[1]}.png")
+        figs[name] = plot_trajectory(tr, title=f"Fig. 8.2: {name}, K = 0.04", units=lp.system.units,
+                                     stick_modes=[lp.stick_mode] if lp.stick_mode is not None else [])
     L.number("hunting amplitude ratio Switch / LuGre at K = 0.04", amps["table8.1-switch"] / amps["table8.1-lugre"], 1.0, 0.05)
+    for name, fig in figs.items():
+        L.on_figure(fig.axes[0], [("amplitude Switch/LuGre", "hunting amplitude ratio Switch / LuGre at K = 0.04",
+                                   ".3f")], loc="lower right", room=0.4,
+                    title=f"hunting cycle, amplitude {amps[name]:.4g} rad (t > 70 s)")
+        save(fig, out / f"fig8_2_{name.split('-')[1]}.png")
 
     branches = {}
     for name, fold_thesis, k_unstable in (("table8.1-lugre", 0.620, 0.615), ("table8.1-switch", 0.647, 0.634)):
@@ -124,9 +142,10 @@ def run(out: Path) -> int:
             unstable=dict(period=po_u.period, amplitude=po_u.amplitude, multipliers=[float(abs(v)) for v in po_u.multipliers]))
         lp = preset(name, K=k_unstable)
         if short == "lugre":     # Fig. 8.5 is drawn below, with the event-map circles added
-            plot_branch(br, title="Fig. 8.3: lugre loop, hunting branch in K",
-                        equilibrium_stable=(np.array([0.0321, 1.0]), np.array([True, True])),
-                        path=out / "fig8_3.png")
+            fig = plot_branch(br, title="Fig. 8.3: lugre loop, hunting branch in K",
+                              equilibrium_stable=(np.array([0.0321, 1.0]), np.array([True, True])))
+            _thesis_fold(L, fig.axes[0], fig.axes[1], short, fold_thesis)
+            save(fig, out / "fig8_3.png")
         plot_cycles(lp.system, [po_s, po_u], [f"stable, K = {k_unstable}", f"unstable, K = {k_unstable}"],
                     title=f"Fig. 8.{4 if short == 'lugre' else 6}: {short} cycles at K = {k_unstable}",
                     eq_bounds=preset("table8.1-switch", K=k_unstable).equilibrium_set(),
@@ -158,7 +177,9 @@ def run(out: Path) -> int:
     plot_branch(branches["switch"], axes=(ax, ax2), title="Fig. 8.5: switch loop, hunting branch in K "
                 "(circles: unstable cycles from the event map)",
                 equilibrium_stable=(np.array([0.0321, 1.0]), np.array([True, True])))
-    ax.plot([r["K"] for r in rows], [r["d"] for r in rows], "o", mfc="w", mec="k", ms=6)
+    ax.plot([r["K"] for r in rows], [r["d"] for r in rows], "o", mfc="w", mec="k", ms=6,
+            label="unstable cycles (event map)")
+    _thesis_fold(L, ax, ax2, "switch", 0.647)
     save(fig, out / "fig8_5.png")
 
     L.save(out / "ch8.json", extra=dict(results=results, seconds=time.perf_counter() - t_start))

@@ -12,7 +12,7 @@ from .. import simulate
 from ..eventmap import event_map, fixed_points, map_diagram
 from ..models import preset
 from ..models import servo as S
-from ..plotting import _plt, save, plot_event_map, plot_map_diagram, plot_trajectory
+from ..plotting import _plt, plot_event_map, plot_map_diagram, plot_trajectory, save, thesis_marks
 from .checks import Ledger
 
 CURVES = {"beta=2": dict(beta=2.0), "beta=1": dict(beta=1.0), "beta=0.5": dict(beta=0.5),
@@ -35,11 +35,21 @@ def run(out: Path) -> int:
     d_seq = tr.events.x_after[tr.events.entering(S.STICK), 0]
     L.number("P(0.1): first stick error", d_seq[0], -0.1223, 5e-5, "m")
     L.fact("stick-slip sequence diverges", bool(np.all(np.diff(np.abs(d_seq)) > 0)), True)
-    plot_trajectory(tr, title="Fig. 9.4: Table 9.1 loop from (0.1, 0, 0)", stick_modes=[S.STICK],
-                    units=loop.system.units, path=out / "fig9_4.png")
+    fig = plot_trajectory(tr, title="Fig. 9.4: Table 9.1 loop from (0.1, 0, 0)", stick_modes=[S.STICK],
+                          units=loop.system.units)
+    t_first = tr.events.t[tr.events.entering(S.STICK)][0]
+    ax = fig.axes[0]
+    ax.plot(t_first, d_seq[0], "o", mfc="w", mec="C0", ms=8, label="hunting: first stick error")
+    thesis_marks(ax, t_first, -0.1223, label="thesis: P(0.1) = -0.1223")
+    ax.legend(fontsize=7, loc="upper left")
+    L.on_figure(ax, [("P(0.1) [m]", "P(0.1): first stick error", ".5f")], loc="lower right", room=0.35)
+    save(fig, out / "fig9_4.png")
     em1 = event_map(loop, np.linspace(-0.5, 0.5, 1001), 1, derivative=False)
-    plot_event_map(em1, cobweb_from=0.1, cobweb_steps=3, title="Fig. 9.5: event map P, cobweb from d = 0.1",
-                   path=out / "fig9_5.png")
+    fig = plot_event_map(em1, cobweb_from=0.1, cobweb_steps=3, title="Fig. 9.5: event map P, cobweb from d = 0.1")
+    thesis_marks(fig.axes[0], 0.1, -0.1223, label="thesis: P(0.1)")
+    fig.axes[0].legend(fontsize=8, loc="upper left")
+    L.on_figure(fig.axes[0], [("P(0.1) [m]", "P(0.1): first stick error", ".5f")])
+    save(fig, out / "fig9_5.png")
     L.fact("P is odd: max |P(d) + P(-d)| < 1e-9", bool(np.nanmax(np.abs(em1.image + em1.image[::-1])) < 1e-9), True)
 
     print("Table 9.2 / Fig. 9.6 -- fixed points of P^2, beta = 2")
@@ -53,7 +63,7 @@ def run(out: Path) -> int:
     L.fact("number of cycles", len(cyc), 2)
     if len(cyc) == 2:
         L.number("d2* (unstable cycle)", cyc[0].d, 0.0034, 1e-4, "m")
-        L.fact("d2* unstable", cyc[0].stable, False)
+        L.fact("d2* unstable", not cyc[0].stable, True)
         L.number("slope of P^2 at d2*", cyc[0].slope, 1.25, 0.01)
         L.number("d3* (stable cycle)", cyc[1].d, 0.2523, 1e-4, "m")
         L.fact("d3* stable", cyc[1].stable, True)
@@ -63,8 +73,16 @@ def run(out: Path) -> int:
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(11, 5))
     plot_event_map(em2, fixed=fps, title="Fig. 9.6: P$^2$, beta = 2 (filled: stable)", ax=axes[0])
+    thesis_marks(axes[0], [0.0, 0.0034, 0.2523], [0.0, 0.0034, 0.2523], label="thesis: d1*, d2*, d3*")
+    axes[0].legend(fontsize=8, loc="upper left")
+    if len(cyc) == 2:
+        L.on_figure(axes[0], [("slope at d1* = 0", "slope of P^2 at the origin", ".4g"),
+                              ("d2* [m]", "d2* (unstable cycle)", ".5g"), ("slope at d2*", "slope of P^2 at d2*", ".4g"),
+                              ("d3* [m]", "d3* (stable cycle)", ".5g"), ("slope at d3*", "slope of P^2 at d3*", ".4g")])
     zoom = event_map(loop, np.linspace(0.0, 0.008, 161), 2, derivative=False)
     plot_event_map(zoom, fixed=[f for f in fps if f.d < 0.008], title="near the equilibrium set", ax=axes[1])
+    thesis_marks(axes[1], [0.0, 0.0034], [0.0, 0.0034], label="thesis: d1*, d2*")
+    axes[1].legend(fontsize=8, loc="upper left")
     fig.tight_layout()
     save(fig, out / "fig9_6.png")
 
@@ -79,12 +97,20 @@ def run(out: Path) -> int:
         results["table9.3"][name] = [f.as_dict() for f in f3]
         e3 = next(f for f in f3 if f.kind == "equilibrium")
         c3 = _cycles(f3)
-        L.fact(f"{name}: equilibrium set unstable", e3.stable, False)
+        L.fact(f"{name}: equilibrium set unstable", not e3.stable, True)
         L.fact(f"{name}: one cycle, stable", (len(c3), all(c.stable for c in c3)), (1, True))
         if c3:
             L.number(f"{name}: d2*", c3[0].d, dstar, 1e-4, "m")
-        print(f"    origin: {e3.origin.behaviour}, P^2(delta)/delta = {e3.slope:.3g} at delta = {e3.origin.probes[0][-1]:.1e}")
+        how = ("slope of the linearization" if e3.origin.method == "linearization" else
+               f"P^2(delta)/delta at delta = {e3.origin.probes[0][-1]:.1e}")
+        print(f"    origin: {e3.origin.behaviour}, {how}: {e3.slope:.3g}")
         plot_event_map(em, fixed=f3, title=f"Fig. 9.7: P$^2$, {name}", ax=ax)
+        thesis_marks(ax, dstar, dstar, label=f"thesis: d2* = {dstar}")
+        ax.legend(fontsize=8, loc="upper left")
+        items = [("equilibrium set unstable", f"{name}: equilibrium set unstable", "")]
+        if c3:
+            items.append(("d2* [m]", f"{name}: d2*", ".5g"))
+        L.on_figure(ax, items)
     fig.tight_layout()
     save(fig, out / "fig9_7.png")
 
@@ -97,8 +123,7 @@ def run(out: Path) -> int:
         diagrams[name] = dg
         results[f"fig9.8 {name}"] = dg.as_dict()
         plot_map_diagram(dg, title=f"Fig. 9.8: {name}", ax=ax)
-    fig.tight_layout()
-    save(fig, out / "fig9_8.png")
+    fig98, axes98 = fig, dict(zip(CURVES, axes.ravel()))
     d2 = diagrams["beta=2"]
     L.fact("beta=2: equilibrium set stable for all P", bool(d2.equilibrium_stable().all()), True)
     last = int(Ps[np.flatnonzero(d2.n_cycles() > 0)[-1]])
@@ -119,6 +144,24 @@ def run(out: Path) -> int:
         L.fact(f"{name}: equilibrium set unstable for all P", bool(not dg.equilibrium_stable().any()), True)
         cyc_ok = all(any(f.kind == "cycle" and f.stable for f in fps) for fps in dg.fixed)
         L.fact(f"{name}: a stable cycle for every P", cyc_ok, True)
+    ax = axes98["beta=2"]
+    ax.axvspan(21, 22, color="C3", alpha=0.12, lw=0, label="thesis: fold between P = 21 and 22")
+    ax.legend(fontsize=7, loc="upper right")
+    L.on_figure(ax, [("last P with cycles", "beta=2: last P with cycles", "")]
+                + ([("fold in (21, 22)", "beta=2: fold between P = 21 and 22", "")] if folds else [])
+                + [("eq. set stable", "beta=2: equilibrium set stable for all P", "")], loc="center right")
+    ax = axes98["beta=1"]
+    thesis_marks(ax, 27.0, 0.0, label="thesis: equilibrium set stable from P = 27")
+    ax.legend(fontsize=7, loc="upper right")
+    L.on_figure(ax, [("unstable to P = 26", "beta=1: equilibrium set unstable up to P = 26", ""),
+                     ("stable from P = 27", "beta=1: equilibrium set stable from P = 27", ""),
+                     ("bound P >", "beta=1: sufficient bound P > (Fs-Fc)/(D vs) + m I/D - b/D", ".4g")],
+                loc="center right")
+    for name in ("beta=0.5", "discontinuous"):
+        L.on_figure(axes98[name], [("eq. set unstable", f"{name}: equilibrium set unstable for all P", ""),
+                                   ("stable cycle", f"{name}: a stable cycle for every P", "")], loc="center right")
+    fig98.tight_layout()
+    save(fig98, out / "fig9_8.png")
 
     print("Table 9.4 -- classification")
     table94 = []
@@ -152,7 +195,8 @@ def run(out: Path) -> int:
         ax.set_title(f"b = {b:g} N s/m", fontsize=9)
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("t [s]")
-    fig.suptitle("Fig. 11.1: Coulomb friction only, decreasing viscous damping")
+    L.on_figure(axes[-1], [("b* [N s/m]", "b* (slope of the linear map P^2 through 1)", ".4f")], room=0.4)
+    fig.suptitle("Fig. 11.1: Coulomb friction only, decreasing viscous damping (last: b = b*)")
     fig.tight_layout()
     save(fig, out / "fig11_1.png")
     lin = A.coulomb_map_slope(preset("table9.1", Fc=4.0))
@@ -177,7 +221,8 @@ def run(out: Path) -> int:
         ax.set_xlabel("x2 [m/s]")
         ax.set_ylabel("F_nl [N]")
         ax.grid(alpha=0.3)
-    fig.suptitle("Fig. 11.3: Stribeck-related block F_nl = g sgn - Fs sgn + (b - b*) v")
+    fig.suptitle(f"Fig. 11.3: Stribeck-related block F_nl = g sgn - Fs sgn + (b - b*) v, b* = {bstar:.4f} "
+                 "(thesis -1.253)")
     fig.tight_layout()
     save(fig, out / "fig11_3.png")
     small = results["fig11.3"]["beta=2"]

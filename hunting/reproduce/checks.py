@@ -26,6 +26,32 @@ class Ledger:
         print(f"  {label:<58} ours {str(ours):>12}  thesis {str(thesis):>10}        {'ok' if ok else 'MISMATCH'}")
         return ok
 
+    def row(self, label: str) -> dict:
+        """The check with this label (or the one check whose label starts with it)."""
+        exact = [r for r in self.rows if r["check"] == label]
+        if exact:
+            return exact[0]
+        (only,) = [r for r in self.rows if r["check"].startswith(label)]
+        return only
+
+    def on_figure(self, ax, items, *, loc: str = "lower right", title: str = "", room: float = 0.0) -> None:
+        """Draw checks on a figure, thesis value beside ours: items are (short label, check
+        label, format) (format for numbers; facts are written as they are); ``room``: see
+        :func:`hunting.plotting.thesis_table`."""
+        from ..plotting import thesis_table
+
+        def text(v, fmt):
+            if isinstance(v, bool):
+                return "yes" if v else "no"
+            if isinstance(v, (int, float)) and fmt:
+                return format(v, fmt)
+            return str(v)
+        rows = []
+        for short, label, fmt in items:
+            r = self.row(label)
+            rows.append((short, text(r["thesis"], fmt), text(r["ours"], fmt), ""))
+        thesis_table(ax, rows, loc=loc, title=title, room=room)
+
     @property
     def failed(self) -> list:
         return [r["check"] for r in self.rows if not r["ok"]]

@@ -1,0 +1,68 @@
+"""``hunting cycle``: a periodic orbit (hunting limit cycle) by simulation and shooting.
+
+Prints the period, the Floquet multipliers, each state's range over the orbit and the stick
+and slip phases; ``--json`` writes period, x0 and min/max by state name, multipliers as
+[re, im] (largest modulus first), phases [{kind, duration}] and stable. No cycle (the motion
+comes to rest, escapes, or does not recur) is a numerical failure: exit 1 with the reason,
+and the JSON (when asked) carries the status and the message.
+"""
+from __future__ import annotations
+
+import sys
+
+from .advice import tell
+from .boundary import UsageError, add_result_arguments, positive_float, result_files, state_spec
+from .systems import add_system_arguments, resolve_system
+
+NAME = "cycle"
+HELP = "find a periodic orbit (hunting cycle): period, multipliers, stick phases"
+
+
+def add_arguments(p) -> None:
+    add_system_arguments(p)
+    p.add_argument("--x0", type=state_spec, metavar="NAME=V,...",
+                   help="where to start, by name (x1=-1) or position (-1,0,0); unnamed states start at 0 "
+                        "(default: a preset's event map, a model's initial values)")
+    p.add_argument("--period-guess", dest="period_guess", type=positive_float, metavar="T",
+                   help="a period guess [s]: shoot from --x0 first (reaches unstable cycles), "
+                        "and scale the transient by it")
+    p.add_argument("--which", choices=("stable", "unstable"), default="stable",
+                   help="for a preset without --x0: the stable (default) or unstable cycle of its event map")
+    p.add_argument("--t-max", dest="t_max", type=positive_float, default=None, metavar="T",
+                   help="bound on the simulated transient before shooting [s] (default 2000 period guesses, "
+                        "else 1e4)")
+    p.add_argument("--d-max", dest="d_max", type=positive_float, default=None, metavar="D",
+                   help="for a preset: the largest stick error its event map is searched on (default: the "
+                        "whole range the map reaches)")
+    add_result_arguments(p, "the orbit", "the orbit with its stick phases shaded")
+
+
+files = result_files
+
+
+def run(args, results) -> int:
+    from ..continuation import StartOptions, find_cycle
+    from ..plotting import plot_cycle
+    choice = resolve_system(args)
+    names = list(choice.system.state_names)
+    x0 = args.x0.vector(names) if args.x0 else None
+    if args.which == "unstable" and (x0 is not None or choice.preset is None) and args.period_guess is None:
+        raise UsageError("--which unstable needs a preset without --x0 (its event map), or --x0 with "
+                         "--period-guess (shooting from there): a simulation never settles on an unstable cycle")
+    start = StartOptions(t_max=args.t_max) if args.t_max is not None else None
+    res = find_cycle(choice.source, x0, args.period_guess, choice.params, which=args.which, d_max=args.d_max,
+                     start=start)
+    if res.success:
+        print(tell(args, res.summary()))
+    if args.json:
+        out = res.as_dict()
+        out.update(preset=choice.preset, model=getattr(args, "model", None), set=choice.overrides)
+        results.write_json(args.json, out, indent=1)
+    if not res.success:
+        print(f"hunting: no cycle ({res.status.name}): {' '.join(tell(args, res.message).split())}", file=sys.stderr)
+        return 1
+    if args.plot:
+        sys_ = choice.system if res.orbit is None or res.orbit.params is None else \
+            choice.system.with_param_array(res.orbit.params)
+        plot_cycle(res, sys_, units=dict(getattr(choice.system, "units", {}) or {}), path=args.plot)
+    return 0
