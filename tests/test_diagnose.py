@@ -50,6 +50,15 @@ def test_clean_data_gives_no_cause():
     assert "µm" in text or " m " in text                 # values carry units
 
 
+def test_noise_free_data_of_the_nominal_model_gives_no_cause():
+    """Noise-free records of the nominal model itself (1 nm encoder, no actuator noise): the
+    residual is the re-simulation's numerical error (1e-5 of the drive force), which a delay of
+    150 ns fitted on both records alike; nothing is a cause below 1e-4 of the drive force."""
+    true = replace(TruePlant(), force_noise=0.0, resolution=1e-9)
+    dg = _run(true, nominal=true_model(true))
+    assert dg.causes == [], [(c.name, c.parameters) for c in dg.causes]
+
+
 @pytest.mark.parametrize("case", ["offset", "asymmetry", "cogging", "mass", "viscous", "lag", "reversal"])
 def test_single_effect_is_named_first_with_its_final_parameters(case):
     """One hidden effect at a moderate size: named first, nothing else selected, its parameters

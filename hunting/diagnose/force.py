@@ -16,7 +16,10 @@ that a strong effect does not pass for noise (the old lag-1 rule collapsed exact
 
 Acceptance (validation data): each member c of the best set must (1) explain the validation
 residual of the set without c out of sample, p < alpha (:func:`stats.out_of_sample`), and (2)
-grow the validation RMS by at least ``min_gain`` (relative) when dropped. Members that fail are
+grow the validation RMS by at least ``min_gain`` (relative) when dropped, and by more than
+``PRECISION`` of the drive force's RMS (absolute: a model that reproduces the data to numerical
+precision has nothing left to explain; on noise-free records of the nominal model itself a
+residual of 1e-5 of the drive force otherwise passed as a 150 ns "delay"). Members that fail are
 removed one at a time (the smallest gain first) and the rest refitted. What remains is the
 explanation; the sets that came next in BIC and the causes of the same family (shared
 signature) that would replace a selected one are its alternatives."""
@@ -31,6 +34,8 @@ from .causes import CAUSES
 from .kinematics import Kinematics, residual
 from .model import NominalModel
 from .stats import NoiseModel, Samples, gls, out_of_sample
+
+PRECISION = 1e-4      # a cause must remove more than this fraction of the drive force's RMS
 
 
 @dataclass
@@ -257,6 +262,7 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
     e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
     noise_v = NoiseModel.fit(e_full, Sv.run)
     current = ranking[0]
+    floor = PRECISION * float(np.sqrt(np.mean(lib.kv.force[lib.used_v] ** 2)))
     while True:
         tests = {}
         rms_full = lib.validation_rms(current)
@@ -273,7 +279,7 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             # the gain: the explanation refitted without it
             rms_wo = lib.validation_rms(without)
             tests[name] = dict(gamma=gamma, t=t, p_value=p, gain=rms_wo / max(rms_full, 1e-300) - 1,
-                               rms_without=rms_wo, rms=rms_full, bic_without=without.bic)
+                               rms_without=rms_wo, rms=rms_full, bic_without=without.bic, floor=floor)
             if lib.kr is not None and getattr(CAUSES[name], "NOISE_FED", False):
                 # the same part along the instrument trajectory: free of the sensor's and the
                 # actuator's noise, which feedback puts into the measured regressors (a delay or
@@ -281,7 +287,8 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                 yr = lib.part(current, name, "r")[Sv.idx]
                 tests[name]["p_reference"] = out_of_sample(e0, yr, Sv.run, noise_v)[2]
         failing = [n for n in current.names if tests[n]["p_value"] >= alpha or tests[n]["gain"] < min_gain
-                   or tests[n].get("p_reference", 0.0) >= alpha_reference]
+                   or tests[n].get("p_reference", 0.0) >= alpha_reference
+                   or tests[n]["rms_without"] - tests[n]["rms"] <= floor]
         if failing:
             worst = min(failing, key=lambda n: tests[n]["gain"])
             rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
@@ -297,7 +304,7 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             for sub in itertools.combinations(current.names, k):
                 alt = fits.get(sub) or lib.best_variants(sub)
                 rms_sub = lib.validation_rms(alt)
-                if rms_sub < (1 + min_gain) * rms_full and alt.physical:
+                if (rms_sub < (1 + min_gain) * rms_full or rms_sub - rms_full <= floor) and alt.physical:
                     beaten.append((len(sub), -alt.bic, sub, rms_sub, alt))
         if not beaten:
             break
@@ -355,6 +362,10 @@ def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) 
                    f"(p = {t['p_reference']:.2g} >= {alpha_reference:g}): the loop's reaction to its own noise")
     if t["gain"] < min_gain:
         out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
+    if t["rms_without"] - t["rms"] <= t["floor"]:
+        out.append(f"it removes {t['rms_without'] - t['rms']:.2g} N RMS of the validation residual, not more than "
+                   f"{PRECISION:g} of the drive force's RMS ({t['floor']:.2g} N): the model already reproduces the "
+                   "data to numerical precision")
     return " and ".join(out)
 
 

@@ -119,6 +119,23 @@ def highpass_response(a: np.ndarray, dt: float, frequency: float, damping: float
     return lfilter(b / den[0], den / den[0], np.asarray(a, dtype=float), axis=0)
 
 
+_NOMINAL_KEYS = {"preset", "set", "plant", "friction", "controller", "sensor"}
+# the keys of a model description (hunting.describe: states and equations), which diagnose cannot
+# map onto its fixed plant + friction law + controller structure
+_DESCRIPTION_KEYS = {"states", "equations", "signals", "parameters", "blocks"}
+_DESCRIPTION_NOT_NOMINAL = ("model file {path} is a model description (states and equations, the format of "
+                            "'hunting simulate --model'); diagnose takes a nominal model JSON with the keys plant, "
+                            "friction, controller, sensor (format in 'hunting diagnose --help', example: "
+                            "examples/emps/model.json)")
+
+
+def _looks_like_description(text: str) -> bool:
+    """Whether a file that is not JSON reads like a YAML model description (an 'equations:' or
+    'states:' key at the start of a line)."""
+    return any(line.split(":", 1)[0].strip() in _DESCRIPTION_KEYS for line in text.splitlines() if ":" in line
+               and not line.startswith((" ", "\t", "#")))
+
+
 @dataclass(frozen=True)
 class NominalModel:
     """mass [kg or kg m^2]; cm : motor constant [N/V] (1 if u is a force); curve : the static
@@ -247,16 +264,26 @@ class NominalModel:
     def from_json(path) -> "NominalModel":
         path = Path(path)
         try:
-            d = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError) as exc:
-            raise SystemDefinitionError(f"model file {path}: {exc}") from None
+            text = path.read_text()
+        except OSError as exc:
+            raise SystemDefinitionError(f"model file {path}: {exc.strerror or exc}") from None
+        try:
+            d = json.loads(text)
+        except json.JSONDecodeError as exc:
+            if path.suffix.lower() in (".yaml", ".yml") or _looks_like_description(text):
+                raise SystemDefinitionError(_DESCRIPTION_NOT_NOMINAL.format(path=path)) from None
+            raise SystemDefinitionError(f"model file {path} is not JSON ({exc.msg} at line {exc.lineno} column "
+                                        f"{exc.colno}); diagnose takes a nominal model JSON, see 'hunting diagnose "
+                                        "--help' and examples/emps/model.json") from None
+        if isinstance(d, dict) and {"states", "equations"} & set(d):
+            raise SystemDefinitionError(_DESCRIPTION_NOT_NOMINAL.format(path=path))
         return NominalModel.from_dict(d)
 
     @staticmethod
     def from_dict(d: dict) -> "NominalModel":
         if not isinstance(d, dict):
             raise SystemDefinitionError(f"model = {d!r} must be a JSON object")
-        unknown = set(d) - {"preset", "set", "plant", "friction", "controller", "sensor"}
+        unknown = set(d) - _NOMINAL_KEYS
         if unknown:
             raise SystemDefinitionError(f"model: unknown keys {sorted(unknown)}; allowed: preset, set, plant, "
                                         "friction, controller, sensor")
