@@ -17,10 +17,11 @@ record's moving samples. Library (H the kinematics' low pass, q v a the filtered
     lag           H[-g'(|v|) a] (a nominal curve with a Stribeck dip only)
     reversal      H[F_LuGre - F_static] along v for slip lengths 2, 10, 50 um
 
-Columns and residual are scaled to unit RMS, so the STLSQ threshold is the share of the
-residual's RMS a term must carry to stay (a small ridge penalty steadies nearly collinear terms).
-A cause is reported when its surviving terms together carry at least that share too; causes are
-ranked by that share. Dwell, saturation and quantization
+Columns and residual are scaled to unit RMS, so the STLSQ threshold lambda is the coefficient a
+term must reach to stay (a share of the residual's RMS; a small ridge penalty steadies nearly
+collinear terms). A cause is reported when the variance share its surviving terms explain
+uniquely (the refit without them leaves that much more) is at least lambda^2, which is what a
+single orthogonal term of coefficient lambda explains; causes are ranked by that share. Dwell, saturation and quantization
 leave no signature in the force residual: the peer cannot report them. The threshold is chosen
 on the tuning seeds (:func:`choose_threshold`) and only then applied to the reporting seeds."""
 from __future__ import annotations
@@ -139,12 +140,22 @@ def library(kin: measures.Kin, nominal: Plant, r: np.ndarray) -> tuple[np.ndarra
     return np.column_stack(cols), names, {"pitch": p, "frequency": f}
 
 
+def _away_from_rest(kin: measures.Kin) -> np.ndarray:
+    """The moving samples at least half a filter period (1 / (2 f_c)) from any sample that does
+    not move: the low pass spreads the stick phases' friction error (the model's F(v) of a noisy
+    v near 0 against the force that holds the mass) that far into the motion around them."""
+    from scipy.ndimage import binary_erosion
+    fc = min(measures.FC_HZ, 0.05 / kin.dt)
+    half = int(math.ceil(0.5 / fc / kin.dt))
+    return binary_erosion(kin.moving, structure=np.ones(2 * half + 1, bool), border_value=0)
+
+
 def fit(kin: measures.Kin, nominal: Plant) -> dict:
     """STLSQ on the fitting record for every threshold in THRESHOLDS: {threshold: [(cause,
     |coefficient|), ...] ranked}, plus physical estimates of the simplest causes at each."""
     import pysindy as ps
     r = measures.residual(kin, nominal)
-    mv = kin.moving
+    mv = _away_from_rest(kin)
     Theta, names, hyper = library(kin, nominal, r)
     X = Theta[mv]
     y = r[mv]
@@ -163,19 +174,32 @@ def fit(kin: measures.Kin, nominal: Plant) -> dict:
             opt.fit(Xs, yn)
         coef = np.asarray(opt.coef_).reshape(-1)
         best: dict = {}
+        support = coef != 0
+        ss_full = _ss(Xs, yn, support)
         for name in dict.fromkeys(names):
-            sel = np.array([n == name for n in names]) & (coef != 0)
-            if sel.any():
-                # the share of the residual's RMS the cause's surviving terms carry together
-                # (||X_c w_c|| = ||R_c w_c||; nearly collinear terms of one cause cancel here)
-                share = float(np.linalg.norm(R[:, sel] @ coef[sel]) / np.sqrt(X.shape[0]))
-                if share >= th:
-                    best[name] = share
+            own = np.array([n == name for n in names]) & support
+            if own.any():
+                # the variance share only this cause's surviving terms explain: the refit
+                # without them leaves that much more (nearly collinear terms of other causes
+                # take over what they can; for one orthogonal term it is its coefficient^2)
+                share = (_ss(Xs, yn, support & ~own) - ss_full) / X.shape[0]
+                if share >= th * th:
+                    best[name] = float(share)
         ranked = sorted(best.items(), key=lambda kv: -kv[1])
         phys = coef * ys / scale
         out[f"{th:.6g}"] = dict(causes=[{"name": n, "weight": w, "parameters": _parameters(n, names, phys, nominal)}
                                         for n, w in ranked])
     return dict(thresholds=out, pitch=hyper["pitch"], frequency=hyper["frequency"])
+
+
+def _ss(R: np.ndarray, z: np.ndarray, cols: np.ndarray) -> float:
+    """Residual sum of squares of z on the columns ``cols`` of R, least squares (the part of
+    ||y||^2 outside R's span is left out: it cancels in differences)."""
+    if not cols.any():
+        return float(z @ z)
+    w, *_ = np.linalg.lstsq(R[:, cols], z, rcond=None)
+    e = z - R[:, cols] @ w
+    return float(e @ e)
 
 
 def _parameters(cause, names, phys, nominal: Plant) -> dict:

@@ -8,7 +8,7 @@ Scoring rules (one place, used by the report and the tests):
   first reported cause is;
 - *extras*: reported causes no effect of the dataset accepts;
 - *moderate*: an effect whose validation gain when modelled exactly (``truth.json`` gain,
-  computed without hunting) is at least MODERATE;
+  computed without hunting) is at least MODERATE = 0.15;
 - parameter error: for a found effect, |reported - true| / |true| of the primary parameters
   (``draw.PRIMARY`` of the reported name) that both the report and the truth hold.
 
@@ -177,49 +177,57 @@ def parameter_errors(rows: list) -> dict:
 
 
 def figure(judged: dict, path: Path) -> None:
-    """Detection against validation gain, one panel per cause: the share of single-effect
-    datasets found (any rank) and named first by each judge, per gain bin; dots: datasets."""
+    """Detection against validation gain, one panel per cause (single-effect datasets): per gain
+    bin the share named first (solid step) and found at any rank (dashed), with the bin's count;
+    dots: datasets at 1 (named first), 0.5 (found, not first) or 0 (missed)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     causes = list(draw.CAUSES)
     ncol = 5
     nrow = math.ceil(len(causes) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(3.2 * ncol, 2.6 * nrow), sharey=True)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(3.3 * ncol, 2.7 * nrow), sharey=True)
     colors = {"hunting": "C0", "peer": "C3"}
+    lo_edge, hi_edge = -0.2, 1.0
     for ax, cause in zip(axes.flat, causes):
         for k, (name, rows) in enumerate(judged.items()):
             effs = [r["effects"][0] for r in rows if r["causes"] == [cause]]
             if not effs:
                 continue
-            g = np.clip([e["gain"] for e in effs], -0.2, 1.0)
             col = colors.get(name.split("-")[0], f"C{k + 1}")
-            y = np.array([e["first"] for e in effs], float) * 1.0 + (k - 0.5) * 0.04
-            ax.plot(g, y, "o", ms=3, color=col, alpha=0.5)
-            centres, first, found = [], [], []
+            g = np.clip([e["gain"] for e in effs], lo_edge, hi_edge)
+            y = np.array([1.0 if e["first"] else (0.5 if e["found"] else 0.0) for e in effs]) + (k - 0.5) * 0.05
+            ax.plot(g, y, "o", ms=3, color=col, alpha=0.45)
             for lo, hi in zip(GAIN_BINS[:-1], GAIN_BINS[1:]):
                 sel = [e for e in effs if lo <= e["gain"] < hi]
-                if sel:
-                    centres.append(float(np.clip(np.mean([e["gain"] for e in sel]), -0.2, 1.0)))
-                    first.append(np.mean([e["first"] for e in sel]))
-                    found.append(np.mean([e["found"] for e in sel]))
-            ax.plot(centres, first, "-", color=col, lw=1.5, label=f"{name}: named first")
-            ax.plot(centres, found, "--", color=col, lw=1.0, label=f"{name}: found")
+                if not sel:
+                    continue
+                x0, x1 = max(lo, lo_edge), min(hi, hi_edge)
+                first = np.mean([e["first"] for e in sel])
+                found = np.mean([e["found"] for e in sel])
+                dy = (k - 0.5) * 0.025                 # judges' equal rates side by side
+                ax.hlines(first + dy, x0, x1, color=col, lw=2.0, label=f"{name}: named first")
+                ax.hlines(found + dy, x0, x1, color=col, lw=1.0, ls="--", label=f"{name}: found")
+                ax.text(0.5 * (x0 + x1), first + 0.04 + 0.09 * k, str(len(sel)), color=col, fontsize=6,
+                        ha="center")
         ax.axvline(MODERATE, color="0.5", lw=0.8, ls=":")
         ax.set_title(cause, fontsize=9)
-        ax.set_ylim(-0.1, 1.1)
-        ax.set_xlim(-0.22, 1.02)
+        ax.set_ylim(-0.1, 1.2)
+        ax.set_xlim(lo_edge - 0.02, hi_edge + 0.02)
         ax.grid(alpha=0.3)
     for ax in axes.flat[len(causes):]:
         ax.axis("off")
     handles, labels = axes.flat[0].get_legend_handles_labels()
-    axes.flat[len(causes)].legend(handles, labels, fontsize=8, loc="center")
+    uniq = dict(zip(labels, handles))
+    axes.flat[len(causes)].legend(uniq.values(), uniq.keys(), fontsize=8, loc="center",
+                                  title="bins: gain < .05, .05-.15, .15-.3, .3-.6, >= .6\nnumbers: datasets per bin",
+                                  title_fontsize=7)
     for ax in axes[-1]:
         ax.set_xlabel("validation gain when modelled", fontsize=8)
     for ax in axes[:, 0]:
         ax.set_ylabel("detection rate", fontsize=8)
-    fig.suptitle("blind benchmark: detection against effect size (single effects; dotted line: moderate = "
-                 f"{MODERATE:g})", fontsize=10)
+    fig.suptitle("blind benchmark: detection against effect size (single effects; dotted: moderate = "
+                 f"{MODERATE:g}; gains below {lo_edge:g} drawn at it)", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -351,8 +359,9 @@ def write(set_dir: Path, judges: dict, out_md: Path, figure_path: Path | None = 
     judged = {name: score(truths, results) for name, results in judges.items()}
     if figure_path is not None:
         figure(judged, figure_path)
-    md = (f"# {title}\n\n" if title else "") + preamble + markdown(Path(set_dir).name, judged,
-                                                                    figure_path.name if figure_path else None)
+    rules = "Scoring rules and targets (benchmarks/blind/report.py):\n\n" + __doc__.split("\n\n", 1)[1] + "\n\n"
+    md = (f"# {title}\n\n" if title else "") + preamble + rules + markdown(Path(set_dir).name, judged,
+                                                                            figure_path.name if figure_path else None)
     out_md.write_text(md)
     return {n: summary(r) for n, r in judged.items()}
 
@@ -368,16 +377,17 @@ def main(argv=None) -> int:
                     help="fix the peer's threshold on this (tuning) set and store it")
     ap.add_argument("--out", type=Path, default=Path(__file__).with_name("RESULTS.md"))
     ap.add_argument("--title", default="Blind benchmark of hunting diagnose")
+    ap.add_argument("--note", default="", help="a paragraph under the title (what was run)")
     a = ap.parse_args(argv)
     judges = {a.hunting: load_results(results_dir(a.set_dir, a.hunting))}
-    pre = ""
+    pre = a.note + "\n\n" if a.note else ""
     if a.peer:
         pdir = results_dir(a.set_dir, "peer")
         if a.choose_threshold:
             choose_peer_threshold(a.set_dir, pdir)
         meta = json.loads(PEER_THRESHOLD.read_text())
         judges["peer"] = peer_results(pdir, meta["threshold"])
-        pre = (f"Peer: pysindy STLSQ on the force residual, threshold {meta['threshold']:.3g} chosen on the "
+        pre += (f"Peer: pysindy STLSQ on the force residual, threshold {meta['threshold']:.3g} chosen on the "
                f"`{meta['chosen_on']}` set ({meta['rule']}).\n\n")
     fig = a.out.with_name(f"detection_{Path(a.set_dir).name}.png")
     S = write(a.set_dir, judges, a.out, fig, title=a.title, preamble=pre)
