@@ -26,9 +26,11 @@ def hyper_bounds(kin, model) -> dict:
 
 
 def design(kin, model, hyper):
-    tau = hyper["tau"]
-    late = np.interp(kin.t - tau, kin.t, kin.drive)
-    return kin.sliding((kin.drive - late) / tau)[:, None]
+    # on top of the model's own delay (the residual's drive is already delayed by it)
+    tau, d0 = hyper["tau"], model.delay
+    now = np.interp(kin.t - d0, kin.t, kin.drive) if d0 > 0 else kin.drive
+    late = np.interp(kin.t - d0 - tau, kin.t, kin.drive)
+    return kin.sliding((now - late) / tau)[:, None]
 
 
 def unphysical(theta, hyper, model) -> str | None:
