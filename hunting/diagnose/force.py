@@ -362,7 +362,7 @@ def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) 
                    f"(p = {t['p_reference']:.2g} >= {alpha_reference:g}): the loop's reaction to its own noise")
     if t["gain"] < min_gain:
         out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
-    if t["rms_without"] - t["rms"] <= t["floor"]:
+    if 0.0 <= t["rms_without"] - t["rms"] <= t["floor"]:     # a cause that makes it worse has its reason above
         out.append(f"it removes {t['rms_without'] - t['rms']:.2g} N RMS of the validation residual, not more than "
                    f"{PRECISION:g} of the drive force's RMS ({t['floor']:.2g} N): the model already reproduces the "
                    "data to numerical precision")
