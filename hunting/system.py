@@ -123,6 +123,10 @@ class PiecewiseSystem:
         True when f(-x) = -f(x) with the mirrored mode (see ``mirror_mode``); lets analyses
         exploit symmetry. Only set it when it is true.
     mirror_mode : int array (n_modes,), the mode of -x for a state in each mode (for odd systems)
+    units : mapping name -> unit, for labels
+    explain : Python callable ``(mode, t, x, p) -> str | None``, optional: names the model's
+        expression that is not finite at a point (compiled models give one; ``simulate`` uses it
+        when the vector field is not finite at the initial state)
     """
 
     name: str
@@ -140,6 +144,7 @@ class PiecewiseSystem:
     odd: bool = False
     mirror_mode: np.ndarray | None = None
     units: Mapping[str, str] = field(default_factory=dict)
+    explain: object | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self):
         set_ = object.__setattr__

@@ -1,21 +1,25 @@
-"""The README's diagnosis figures: the EMPS worked example (needs ../shared/data/emps/) and the
-measured event maps of table 9.1 with a wrong Stribeck level.
+"""The diagnosis figures: the EMPS worked example (its files in $HUNTING_DATA/emps or
+../shared/data/emps) and the measured event maps of table 9.1 with a wrong Stribeck level. (The
+blind benchmark's figure, docs/figures/diagnose_blind_tuning.png, is benchmarks/blind/report.py's.)
 
     python docs/figures/make_diagnose_figures.py
 """
 from __future__ import annotations
 
+import os
 import shutil
 import sys
 import tempfile
 from pathlib import Path
 
-from hunting.diagnose import NominalModel, diagnose, fit_coulomb_viscous, kinematics, load
+
+from hunting.diagnose import NominalModel, diagnose, load
 from hunting.diagnose.report import write_report
 from hunting.diagnose.synthetic import regulator
 
 HERE = Path(__file__).resolve().parent
-EMPS = HERE.parents[1].parent / "shared" / "data" / "emps"
+EMPS = (Path(os.environ["HUNTING_DATA"]) / "emps" if os.environ.get("HUNTING_DATA")
+        else HERE.parents[1].parent / "shared" / "data" / "emps")
 
 
 def _report(dg, copies: dict) -> None:
@@ -30,11 +34,8 @@ def emps() -> None:
     if not (EMPS / "DATA_EMPS.mat").is_file():
         print(f"EMPS data not found in {EMPS}: its figures are not remade", file=sys.stderr)
         return
-    fit = load(EMPS / "DATA_EMPS.mat")
-    val = load(EMPS / "DATA_EMPS_PULSES.mat", names={"f_ext": None, "u_inj": "pulses_N"})
-    model, _ = fit_coulomb_viscous(kinematics(fit, 35.15065188))
-    model = model.replace(controller={"type": "pd-velocity-loop", "kp": 160.18, "kv": 243.45, "sample_time": 1e-3,
-                                      "saturation": 10.0})
+    fit, val = load(EMPS / "DATA_EMPS.mat"), load(EMPS / "DATA_EMPS_PULSES.mat")
+    model = NominalModel.from_json(HERE.parents[1] / "examples" / "emps" / "model.json")
     _report(diagnose(fit, model, val), {"residual.png": "emps_residual.png", "behaviour.png": "emps_behaviour.png"})
 
 

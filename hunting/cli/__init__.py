@@ -18,6 +18,8 @@
     hunting demo [--out DIR]            short simulations of chapters 4, 8 and 9, checked
     hunting diagnose DATA --model MODEL.json [--validate DATA2] [--json FILE] [--report DIR]
                      [--names KEY=COLUMN,...] [--drop COLUMN]   measured data against the model
+    hunting data emps [--dir DIR] [--force]   the EMPS benchmark's files (found or downloaded,
+                                        verified) and its example model, ready to diagnose
 
 Every command checks its arguments and output paths before computing, writes result files
 whole (a temporary file, then a rename; devices, FIFOs and ``/dev/stdout`` directly, see
@@ -45,7 +47,7 @@ from ..errors import ConvergenceError, HuntingError
 from .advice import Command, command_of, for_cli
 from .boundary import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, ArgumentParser, Results, check_files, names_stdout
 
-COMMANDS = ("models", "simulate", "eventmap", "continue_", "cycle", "reproduce", "demo", "diagnose")
+COMMANDS = ("models", "simulate", "eventmap", "continue_", "cycle", "reproduce", "demo", "diagnose", "data")
 EXIT_BROKEN_PIPE = 141          # what a shell reports for a command ended by SIGPIPE
 
 

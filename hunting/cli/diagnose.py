@@ -1,21 +1,37 @@
 """``hunting diagnose``: measured data against a nominal model (causes, extension, gain)."""
 from __future__ import annotations
 
+import argparse
+import sys
+
 from ..errors import HuntingError
 from .boundary import Input, Output
 
 NAME = "diagnose"
 HELP = "measured data against the model: causes, extension, gain"
+DATA_HELP = """\
+DATA and --validate: CSV with a header row, .npz or .mat, one row per sample at a fixed interval:
+  t [s], q [m or rad], u (controller output, what cm multiplies), optional q_ref (reference),
+  f_ext [N] (known force on the load), u_inj (a known signal inside u, e.g. test pulses).
+  Other names map with --names (e.g. q=qm,u=vir); the EMPS benchmark's are known (qm, vir, qg,
+  pulses_N as u_inj). Without --validate the last 40 % of DATA is the validation data.
+
+Example (the EMPS benchmark, its files from nonlinearbenchmark.org):
+  hunting diagnose DATA_EMPS.mat --validate DATA_EMPS_PULSES.mat --model examples/emps/model.json
+"""
 
 
 def add_arguments(p) -> None:
-    p.add_argument("data", help="CSV (header t,q,u[,q_ref,f_ext]), .npz or .mat")
-    p.add_argument("--model", required=True, help="MODEL.json (see hunting.diagnose.model)")
+    from ..diagnose.model import SCHEMA_HELP
+    p.formatter_class = argparse.RawDescriptionHelpFormatter
+    p.epilog = DATA_HELP + "\n" + SCHEMA_HELP
+    p.add_argument("data", help="measured data (CSV, .npz or .mat; columns below)")
+    p.add_argument("--model", required=True, help="the nominal model as JSON (format below)")
     p.add_argument("--validate", help="validation data (default: the last 40 %% of DATA)")
     p.add_argument("--names", help="column names in the files, e.g. q=qm,u=vir")
-    p.add_argument("--drop", action="append", help="leave this column out (e.g. f_ext)")
+    p.add_argument("--drop", action="append", help="leave this optional column out (e.g. u_inj)")
     p.add_argument("--json", metavar="FILE", help="the diagnosis as JSON ('-': standard output)")
-    p.add_argument("--report", metavar="DIR", help="directory for index.html, residual.png, diagnosis.json")
+    p.add_argument("--report", metavar="DIR", help="directory for index.html, figures, diagnosis.json")
 
 
 def files(args):
@@ -37,26 +53,27 @@ def _parse_names(text, drop) -> dict | None:
 
 
 def run(args, results) -> int:
+    from tqdm import tqdm
+
     from ..diagnose import NominalModel, diagnose, load
-    from ..diagnose.report import write_report
+    from ..diagnose.report import format_terminal, write_report
     names = _parse_names(args.names, args.drop)
+    model = NominalModel.from_json(args.model)
     fit = load(args.data, names)
     val = load(args.validate, names) if args.validate else None
-    model = NominalModel.from_json(args.model)
-    dg = diagnose(fit, model, val)
-    for g in dg.gains():
-        print(f"validation {g['metric']}: nominal {g['nominal']} -> extended {g['extended']}")
-    for note in dg.notes:
-        print(f"note: {note}")
-    print(f"criterion: {dg.criterion}")
-    if not dg.causes:
-        print("no cause found: the nominal model explains the data within the criterion")
-    for i, c in enumerate(dg.causes):
-        pars = ", ".join(f"{k} = {v:.5g}" + ("" if c.sigma.get(k) is None else f" +- {c.sigma[k]:.2g}")
-                         for k, v in c.parameters.items())
-        print(f"  {i + 1}. {c.name:<10} score {c.score:.3g}  p {c.p_value:.2g}  {pars}")
-    for a in dg.alternatives:
-        print(f"     (also explains the data alone: {a['name']} {a['parameters']}; absorbed by {a['absorbed_by']})")
+    bar = tqdm(total=1, desc="diagnose", file=sys.stderr, disable=not sys.stderr.isatty(), leave=False,
+               bar_format="{desc}: {n}/{total} {bar} {elapsed}")
+
+    def progress(stage, done, total):
+        bar.total = total
+        bar.n = done
+        bar.set_description(f"diagnose: {stage}")
+        bar.refresh()
+    try:
+        dg = diagnose(fit, model, val, progress=progress)
+    finally:
+        bar.close()
+    print(format_terminal(dg))
     if args.json:
         results.write_json(args.json, dg.as_dict(), indent=2, default=float)   # the format of report.write_json
     if args.report:

@@ -3,6 +3,7 @@ with its names, parameter layout and friction contacts."""
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
@@ -12,7 +13,8 @@ import numpy as np
 from ..errors import SystemDefinitionError, check_finite
 from ..system import Mode, PiecewiseSystem
 from . import cache
-from .description import GENERATOR_VERSION, Spec
+from .description import GENERATOR_VERSION, SLIP_VARIABLE, Spec
+from .expressions import TIME, evaluate, first_non_finite, parse
 
 PART_NAMES = ("slip+", "slip-", "stick")
 
@@ -134,7 +136,8 @@ class CompiledModel:
                 guard_names=tuple(meta["guard_names"]), param_names=self.layout.param_names,
                 params=params if len(params) else np.zeros(1), vector_field=module.vf, guards=module.guards,
                 transition=module.reset, mode_of=module.mode_of, jacobian=module.jac,
-                units=dict(spec.description.get("units", {})))
+                units=dict(spec.description.get("units", {})),
+                explain=self.explain_non_finite)
         self.system = system
 
     # ------------------------------------------------------------------ names and layout
@@ -187,7 +190,21 @@ class CompiledModel:
             val = check_finite(f"parameter {k}", v)
             new[slot] = val
         self._spec.check_parameter_values(dict(zip(self.param_names, new)))
+        self._check_blocks(new)
         return new
+
+    def _check_blocks(self, params: np.ndarray) -> None:
+        """Raise when a parameter value makes a linear block's leading denominator coefficient
+        zero (the block's realization divides by it)."""
+        for b in self._meta.get("block_leads", ()):
+            v = evaluate_or_nan(parse(b["lead"], "lead"), {f"p_{j}": float(x) for j, x in enumerate(params)})
+            if v == 0 or not math.isfinite(v):
+                used = ", ".join(f"{n} = {params[j]:g}" for j, n in enumerate(self.param_names)
+                                 if f"p_{j}" in parse(b["lead"], "lead").names)
+                raise SystemDefinitionError(
+                    f"blocks[{b['output']!r}]: the leading coefficient of the denominator, {b['text']}, is {v:g} "
+                    f"with {used}: the transfer function is not defined (allowed: parameter values that keep it "
+                    "nonzero)")
 
     def with_params(self, values: Mapping[str, float] | None = None, /, **kw) -> "CompiledModel":
         """Copy with named parameter values replaced; nothing recompiles.
@@ -261,6 +278,58 @@ class CompiledModel:
         self._module.pjac(self._mode(x, t, mode), float(t), x, self.system.params, J)
         return J
 
+    def explain_non_finite(self, mode: int, t: float, x, p) -> str | None:
+        """Which expression of the description is not finite at (mode, t, x, p), in words, or
+        None when every signal, friction term and equation is finite there. Signals first (in
+        the order they are computed), then each contact's velocity and force, then the
+        equations: the first one named is the cause, the later ones inherit it.
+
+        For example ``"equations['v'] = '(u - F)/m' is not finite: division by m = 0"``."""
+        spec = self._spec
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        p = np.ascontiguousarray(p, dtype=np.float64)
+        values = {TIME: float(t), **{n: float(v) for n, v in zip(self.param_names, p)},
+                  **{n: float(v) for n, v in zip(self.state_names, x)}}
+        out = np.empty(max(1, len(self.signal_names)))
+        self._module.signals(int(mode), float(t), x, p, out)
+        values.update(zip(self.signal_names, out.tolist()))
+
+        def why(where, expr, extra=None):
+            detail = first_non_finite(expr, {**values, **(extra or {})})
+            if detail is None:
+                return None
+            return f"{where} = {expr.text!r} is not finite: {detail}"
+
+        for k in spec.signal_order:
+            if k in spec.signals and not math.isfinite(values[k]):
+                text = why(f"signals[{k!r}]", spec.signals[k])
+                if text:
+                    return text
+        for b in spec.blocks:
+            if not math.isfinite(values[b.output]):
+                return (f"the output of blocks[{b.output!r}] is {values[b.output]} "
+                        f"(its input {b.input.text!r} = {evaluate_or_nan(b.input, values):.6g})")
+        for c, cc in zip(spec.contacts, self.contacts):
+            w = float(self._module._w(cc.index, float(t), x, p))
+            name = f"friction[{c.name!r}]"
+            if not math.isfinite(w):
+                return why(f"{name}.velocity", c.velocity) or f"{name}.velocity is {w}"
+            if not math.isfinite(values[c.force]):
+                part = cc.part(int(mode))
+                laws = ([("slip", c.slip)] if part != "stick" else [("stick", c.stick[0]), ("stick", c.stick[1])]) \
+                    if c.model == "switch" else [("level", c.level), ("sigma0", c.sigma0), ("sigma1", c.sigma1),
+                                                 ("viscous", c.viscous)]
+                for key, e in laws:
+                    text = why(f"{name}.{key}", e, {SLIP_VARIABLE: w})
+                    if text:
+                        return text
+                return f"the friction force {c.force} of {name} is {values[c.force]} ({part})"
+        for s_, e in spec.equations.items():
+            text = why(f"equations[{s_!r}]", e)
+            if text:
+                return text
+        return None
+
     def summary(self) -> str:
         """Text listing of the model: states, parameters with values, signals, contacts, modes
         (for command-line listings)."""
@@ -300,8 +369,26 @@ def compile_spec(spec: Spec):
             "mode_parts": [list(pt) for pt in sym.modes], "signal_names": list(sym.signal_names),
             "contacts": [{"surface": int(sym.surface[i]),
                           "bristle": sym.bristle_states.get(c.state) if c.model == "lugre" else None}
-                         for i, c in enumerate(sym.contacts)]}
+                         for i, c in enumerate(sym.contacts)],
+            "block_leads": _block_leads(sym)}
     return cache.store(digest, source, meta)
+
+
+def evaluate_or_nan(expr, values: dict) -> float:
+    """``evaluate``, NaN where it fails (for messages about values that are already bad)."""
+    try:
+        return evaluate(expr, values)
+    except SystemDefinitionError:
+        return math.nan
+
+
+def _block_leads(sym) -> list:
+    """The leading denominator coefficients of the linear blocks that depend on parameters, as
+    text in the parameter slots p_j (checked at every parameter change) and in their names."""
+    import sympy as sp
+    names = {p: sp.Symbol(n) for p, n in zip(sym.p, sym.param_names)}
+    return [{"output": out, "lead": str(lead), "text": str(lead.subs(names))}
+            for out, lead in sym.block_leads if lead.free_symbols]
 
 
 def build_model(spec: Spec, overrides: Mapping[str, float] | None = None) -> CompiledModel:
@@ -309,4 +396,7 @@ def build_model(spec: Spec, overrides: Mapping[str, float] | None = None) -> Com
     module, meta = compile_spec(spec)
     params = np.array([spec.parameters[k] for k in meta["param_names"]], dtype=np.float64)
     m = CompiledModel(spec, module, meta, params)
-    return m.with_params(overrides) if overrides else m
+    if overrides:
+        return m.with_params(overrides)           # checks the values
+    m._check_blocks(m.system.params)
+    return m

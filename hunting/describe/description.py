@@ -131,17 +131,45 @@ class Spec:
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
     def check_parameter_values(self, values: dict) -> None:
-        """Raise when a stick bound that depends on parameters only is negative at ``values``."""
+        """Raise when a stick bound that depends on parameters only is negative at ``values``,
+        or lower than the slip force next to w = 0 (where both depend on parameters only)."""
+        known = set(self.parameters) | set(CONSTANTS)
         for c in self.contacts:
             if c.stick is None:
                 continue
+            bounds = []
             for side, e in zip(("negative-direction", "positive-direction"), c.stick):
-                if e.names <= set(self.parameters) | set(CONSTANTS):
+                if e.names <= known:
                     v = evaluate(e, values)
                     if not (v >= 0 and math.isfinite(v)):
                         raise SystemDefinitionError(
                             f"friction[{c.name!r}].stick = {e.text!r} is {v!r} at the parameter values: "
                             f"the {side} stick bound must be a finite number >= 0")
+                    bounds.append(v)
+            if len(bounds) == 2 and c.slip.names <= known | {SLIP_VARIABLE}:
+                _check_break_away(c, bounds, values)
+
+
+_W_NEAR_ZERO = 1e-12     # [velocity] where the slip force next to w = 0 is read
+
+
+def _check_break_away(c: "ContactSpec", bounds: list, values: dict) -> None:
+    """A Switch contact leaves stick when its force reaches a stick bound; the slip force just
+    after must not exceed that bound, or the contact is pushed straight back onto w = 0 and
+    chatters between stick and slip (a Zeno run). Static friction >= kinetic, in the model's
+    words: |slip(0+)| <= stick bound (positive side), |slip(0-)| <= stick bound (negative)."""
+    for k, (side, s) in enumerate((("negative", -1.0), ("positive", 1.0))):
+        try:
+            f = s * evaluate(c.slip, {**values, SLIP_VARIABLE: s * _W_NEAR_ZERO})
+        except SystemDefinitionError:
+            return                      # a law not defined at w -> 0: the run will say
+        if f > bounds[k] * (1 + 1e-9) + 1e-12:
+            stick = c.stick[k].text
+            raise SystemDefinitionError(
+                f"friction[{c.name!r}]: the slip force at w -> 0{'+' if s > 0 else '-'} is {f:.6g}, more than the "
+                f"{side}-direction stick bound {stick!r} = {bounds[k]:.6g}: a contact that breaks free would be "
+                "pushed straight back to w = 0 and chatter (allowed: stick bounds >= the slip force at w = 0, "
+                "static friction at least the kinetic)")
 
 
 _GEN_DIGEST: list = []
@@ -361,15 +389,25 @@ def validate(desc) -> Spec:
         if c["model"] == "switch":
             slip = _expr(c["slip"], f"{w}.slip", law_names, law_what)
             st = c["stick"]
+            stick_what = "stick bounds use parameters, t and signals that depend on neither forces nor states"
             if isinstance(st, (list, tuple)):
                 if len(st) != 2:
                     raise SystemDefinitionError(f"{w}.stick = {st!r}: give one bound (symmetric) or two, [neg, pos] "
                                                 "(the stick set is [-neg, pos])")
-                pair = tuple(_expr(e, f"{w}.stick[{j}]", free, "stick bounds use parameters, states, t and "
-                                   "force-free signals") for j, e in enumerate(st))
+                pair = tuple(_expr(e, f"{w}.stick[{j}]", free, stick_what) for j, e in enumerate(st))
+                where_st = [f"{w}.stick[{j}]" for j in range(2)]
             else:
-                e = _expr(st, f"{w}.stick", free, "stick bounds use parameters, states, t and force-free signals")
-                pair = (e, e)
+                e = _expr(st, f"{w}.stick", free, stick_what)
+                pair, where_st = (e, e), [f"{w}.stick"] * 2
+            for e, where in zip(pair, where_st):
+                # the stick set is fixed while the contact sticks: a bound that moves with the
+                # state crosses the stick force (or the slip force) as the free states drift,
+                # and the contact chatters between stick and slip
+                moving = sorted(e.names & (set(states) | bristles)) + sorted(k for k in e.names if uses_state.get(k))
+                if moving:
+                    raise SystemDefinitionError(
+                        f"{where} = {e.text!r} depends on the state through {', '.join(moving)} (allowed: {stick_what}; "
+                        "a stick bound is fixed while the contact sticks)")
             contacts.append(ContactSpec(cn, "switch", c["force"], vel, slip=slip, stick=pair))
         else:
             z0 = c.get("z0", 0.0)

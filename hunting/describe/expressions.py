@@ -17,6 +17,8 @@ import math
 import operator
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..errors import SystemDefinitionError
 
 #: function name -> number of arguments (None: two or more)
@@ -170,6 +172,60 @@ def evaluate(expr: Expr, values: dict) -> float:
         return float(_walk(expr, float, name, lambda f, args: _MATH[f](*args)))
     except (ValueError, ZeroDivisionError, OverflowError, TypeError) as e:
         raise SystemDefinitionError(f"{expr.text!r} cannot be evaluated at {values}: {e}") from None
+
+
+_NUMPY = {"abs": np.abs, "sign": np.sign, "exp": np.exp, "log": np.log, "sqrt": np.sqrt, "tanh": np.tanh,
+          "sin": np.sin, "cos": np.cos, "min": lambda *a: np.min(a), "max": lambda *a: np.max(a)}
+
+
+def first_non_finite(expr: Expr, values: dict) -> str | None:
+    """Where ``expr`` stops being finite at ``values`` (floats by name), in words: the innermost
+    name, operation or function whose value is NaN or inf while its operands are finite, e.g.
+    ``"division by m = 0"`` or ``"log(x) of -1"``; None when the value is finite. Evaluated in
+    IEEE arithmetic (no exceptions), as the compiled model computes it."""
+    found: list = []
+
+    def note(text):
+        if not found:
+            found.append(text)
+
+    def operands(node) -> str:
+        used = sorted({n.id for n in ast.walk(node) if isinstance(n, ast.Name)} - set(CONSTANTS))
+        return ", ".join(f"{n} = {float(values[n]):.6g}" for n in used if n in values)
+
+    def ev(node):
+        if isinstance(node, ast.Constant):
+            return np.float64(node.value)
+        if isinstance(node, ast.Name):
+            v = np.float64(values[node.id] if node.id in values else CONSTANTS.get(node.id, np.nan))
+            if not np.isfinite(v):
+                note(f"{node.id} = {v}")
+            return v
+        if isinstance(node, ast.UnaryOp):
+            v = ev(node.operand)
+            return -v if isinstance(node.op, ast.USub) else v
+        if isinstance(node, ast.BinOp):
+            left, right = ev(node.left), ev(node.right)
+            v = _BINARY[type(node.op)](left, right)
+            if not np.isfinite(v) and np.isfinite(left) and np.isfinite(right):
+                den = ast.unparse(node.right)
+                if isinstance(node.op, ast.Div) and right == 0:
+                    where = operands(node.right)
+                    note(f"division by {den} = 0" + ("" if where == f"{den} = 0" else f" ({where})"))
+                else:
+                    note(f"{ast.unparse(node)} is {v} ({operands(node)})")
+            return v
+        args = [ev(a) for a in node.args]
+        v = np.float64(_NUMPY[node.func.id](*args))
+        if not np.isfinite(v) and all(np.isfinite(a) for a in args):
+            note(f"{ast.unparse(node)} is {v} ({operands(node)})")
+        return v
+
+    with np.errstate(all="ignore"):
+        value = ev(expr.tree)
+    if np.isfinite(value):
+        return None
+    return found[0] if found else f"its value is {value}"
 
 
 def to_sympy(expr: Expr, symbols: dict):

@@ -35,7 +35,8 @@ class Symbolic:
     {contact: dw/dt} for LuGre contacts; signals : per mode list of the output values
     (``signal_names``); contact helpers (per contact): w, surface (state index), dwdx (d w / d
     x_surface), orient (-d(dw/dt)/dF: > 0 when the force opposes w), lo, hi (stick bound
-    magnitudes, Switch only)."""
+    magnitudes, Switch only); block_leads: (block output, leading denominator coefficient) per
+    linear block (a parameter value that makes it 0 leaves the block undefined)."""
 
     state_names: tuple
     param_names: tuple
@@ -62,6 +63,7 @@ class Symbolic:
     lo: list
     hi: list
     bristle_states: dict
+    block_leads: tuple = ()
 
     @property
     def n_guards(self) -> int:
@@ -87,11 +89,17 @@ def _block_coefficients(b: BlockSpec, psym: dict):
     if b.tf is not None:
         s = sp.Symbol(TF_VARIABLE)
         h = sp.together(to_sympy(b.tf, {**psym, TF_VARIABLE: s}))
+        if h.has(sp.zoo, sp.oo, -sp.oo, sp.nan):      # 1/(0*s), 1/(s - s): sympy's 1/0 is zoo
+            raise SystemDefinitionError(f"{where}.tf = {b.tf.text!r}: the denominator is zero (the transfer "
+                                        "function is not defined)")
         num, den = sp.fraction(h)
         try:
             pn, pd = sp.Poly(sp.expand(num), s), sp.Poly(sp.expand(den), s)
         except sp.PolynomialError:
             raise SystemDefinitionError(f"{where}.tf = {b.tf.text!r} is not a rational function of s") from None
+        if pd.is_zero:
+            raise SystemDefinitionError(f"{where}.tf = {b.tf.text!r}: the denominator is zero (the transfer "
+                                        "function is not defined)")
         return pn.all_coeffs()[::-1], pd.all_coeffs()[::-1]
     num = [to_sympy(e, psym) for e in b.num][::-1]
     den = [to_sympy(e, psym) for e in b.den][::-1]
@@ -100,8 +108,8 @@ def _block_coefficients(b: BlockSpec, psym: dict):
 
 def _realize(b: BlockSpec, psym: dict):
     """Controllable canonical form of a block: (A rows as lambdas of the states, ...). Returns
-    (a, c, D): normalized denominator coefficients a_0..a_{n-1}, output coefficients c_0..c_{n-1},
-    feed-through D, for xi' = [xi_2, ..., xi_n, u - sum a_i xi_{i+1}], y = sum c_i xi_{i+1} + D u."""
+    (a, c, D, lead): normalized denominator coefficients a_0..a_{n-1}, output coefficients
+    c_0..c_{n-1}, feed-through D and the leading denominator coefficient (it divides the others), for xi' = [xi_2, ..., xi_n, u - sum a_i xi_{i+1}], y = sum c_i xi_{i+1} + D u."""
     import sympy as sp
     where = f"blocks[{b.output!r}]"
     num, den = _block_coefficients(b, psym)
@@ -123,7 +131,7 @@ def _realize(b: BlockSpec, psym: dict):
     bn = [v / lead for v in bn]
     D = bn[n]
     c = [bn[i] - D * a[i] for i in range(n)]
-    return a, c, D
+    return a, c, D, lead
 
 
 def directional(expr, wsym, s: int, w_value):
@@ -155,7 +163,11 @@ def build(spec: Spec) -> Symbolic:
     psym = dict(zip(pnames, p))
 
     # blocks -> state names
-    realized = [_realize(b, psym) for b in spec.blocks]
+    realized, leads = [], []
+    for b in spec.blocks:
+        a, c, D, lead = _realize(b, psym)
+        realized.append((a, c, D))
+        leads.append((b.output, lead))
     bristles = {c.state: c for c in spec.contacts if c.model == "lugre"}
     names = list(spec.states) + list(bristles)
     block_states = []
@@ -378,4 +390,4 @@ def build(spec: Spec) -> Symbolic:
 
     return Symbolic(tuple(names), pnames, t, x, p, contacts, tuple(strides), tuple(modes), tuple(mode_names),
                     tuple(guard_names), vf, guards, jac, pjac, stick_force, wdot, out_names, signals, w, surface,
-                    dwdx, orient, lo, hi, bristle_index)
+                    dwdx, orient, lo, hi, bristle_index, tuple(leads))

@@ -2,10 +2,11 @@
 
 Columns (any file type): ``t`` [s], ``q`` [m or rad], ``u`` (controller output, in the unit the
 motor constant multiplies), optional ``q_ref`` (reference), ``f_ext`` (known external force on the
-load) and ``u_inj`` (a known signal added to the controller output, e.g. test pulses).
-MATLAB and NumPy files may use other variable names through ``names`` (e.g. the EMPS files:
-``{"q": "qm", "u": "vir", "q_ref": "qg", "f_ext": "pulses_N"}``; those are tried by default);
-``names={"f_ext": None}`` leaves a column out."""
+load) and ``u_inj`` (a known signal added to the controller output, e.g. test pulses: already part
+of u, used by the re-simulation). Other variable names map through ``names`` (e.g.
+``{"q": "qm", "u": "vir"}``); the EMPS benchmark's names are tried by default (``qm``, ``vir``,
+``qg``, and ``pulses_N`` as ``u_inj``: its README shows the pulses are inside ``vir``, a 5 V
+injection, not a force on the load); ``names={"u_inj": None}`` leaves a column out."""
 from __future__ import annotations
 
 import csv
@@ -19,7 +20,7 @@ from ..errors import SystemDefinitionError
 REQUIRED = ("t", "q", "u")
 OPTIONAL = ("q_ref", "f_ext", "u_inj")
 ALIASES = {"t": ("t", "time"), "q": ("q", "qm", "position"), "u": ("u", "vir", "input"),
-           "q_ref": ("q_ref", "qg", "reference"), "f_ext": ("f_ext", "pulses_N"), "u_inj": ("u_inj",)}
+           "q_ref": ("q_ref", "qg", "reference"), "f_ext": ("f_ext",), "u_inj": ("u_inj", "pulses_N")}
 
 
 @dataclass(frozen=True)
@@ -43,18 +44,29 @@ class Measurement:
             v = getattr(self, k)
             if v is None:
                 continue
-            a = np.asarray(v, dtype=float).ravel()
+            try:
+                a = np.asarray(v, dtype=float).ravel()
+            except (TypeError, ValueError):
+                raise SystemDefinitionError(f"{self.name}: column {k} = {str(v)[:40]!r} is not numeric") from None
             if a.size != n:
                 raise SystemDefinitionError(f"{self.name}: column {k} has {a.size} samples, t has {n}")
             if not np.all(np.isfinite(a)):
-                raise SystemDefinitionError(f"{self.name}: column {k} has NaN or inf values")
+                bad = np.flatnonzero(~np.isfinite(a))
+                raise SystemDefinitionError(f"{self.name}: column {k} has {bad.size} NaN or inf values (first at "
+                                            f"sample {int(bad[0])}): remove or interpolate them")
             object.__setattr__(self, k, a)
         if n < 50:
             raise SystemDefinitionError(f"{self.name}: {n} samples are too few (need >= 50)")
         dt = np.diff(self.t)
-        if np.any(dt <= 0) or np.ptp(dt) > 1e-3 * np.mean(dt):
-            raise SystemDefinitionError(f"{self.name}: t must be uniformly sampled and increasing "
-                                        f"(steps from {dt.min():.3g} to {dt.max():.3g} s)")
+        if np.any(dt <= 0):
+            k = int(np.flatnonzero(dt <= 0)[0])
+            raise SystemDefinitionError(f"{self.name}: t must increase: sample {k + 1} has t = {float(self.t[k + 1]):.6g} s "
+                                        f"after t = {float(self.t[k]):.6g} s (sort the rows or remove repeated times)")
+        if np.ptp(dt) > 1e-3 * np.mean(dt):
+            k = int(np.argmax(np.abs(dt - np.median(dt))))
+            raise SystemDefinitionError(f"{self.name}: t must be uniformly sampled: steps range from {dt.min():.6g} "
+                                        f"to {dt.max():.6g} s (e.g. at sample {k + 1}, t = {self.t[k + 1]:.6g} s); "
+                                        "resample the data to a fixed interval")
 
     @property
     def dt(self) -> float:
@@ -75,9 +87,15 @@ class Measurement:
 
 
 def _pick(found: dict, names: dict | None, path: Path) -> dict:
+    unknown = sorted(set(names or {}) - set(REQUIRED + OPTIONAL))
+    if unknown:
+        raise SystemDefinitionError(f"{path}: column keys {unknown} are not known: use {list(REQUIRED + OPTIONAL)}")
     cols = {}
     for k in REQUIRED + OPTIONAL:
         if names and k in names and names[k] is None:
+            if k in REQUIRED:
+                raise SystemDefinitionError(f"{path}: column {k!r} cannot be left out (required: {list(REQUIRED)}; "
+                                            f"optional, may be dropped: {list(OPTIONAL)})")
             continue                         # the caller excludes this column
         cands = (names[k],) if names and k in names else ALIASES[k]
         hit = next((c for c in cands if c in found), None)
@@ -86,7 +104,10 @@ def _pick(found: dict, names: dict | None, path: Path) -> dict:
                 raise SystemDefinitionError(f"{path}: no column for {k!r} (tried {list(cands)}; "
                                             f"the file has {sorted(found)})")
             continue
-        cols[k] = np.asarray(found[hit], dtype=float).ravel()
+        try:
+            cols[k] = np.asarray(found[hit], dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise SystemDefinitionError(f"{path}: column {hit!r} (for {k!r}) is not numeric") from None
     return cols
 
 
@@ -102,22 +123,45 @@ def load(path, names: dict | None = None) -> Measurement:
         if len(rows) < 2:
             raise SystemDefinitionError(f"{path}: needs a header row and data rows")
         header = [h.strip() for h in rows[0]]
-        try:
-            data = np.array([[float(x) for x in r] for r in rows[1:] if r], dtype=float)
-        except ValueError as exc:
-            raise SystemDefinitionError(f"{path}: non-numeric value ({exc})") from None
-        if data.shape[1] != len(header):
-            raise SystemDefinitionError(f"{path}: {data.shape[1]} columns of data, {len(header)} names in the header")
+        body = []
+        for line, r in enumerate(rows[1:], start=2):
+            if not r:
+                continue
+            if len(r) != len(header):
+                raise SystemDefinitionError(f"{path}: line {line} has {len(r)} fields, the header has {len(header)} "
+                                            f"({', '.join(header)}): every row needs one value per column")
+            try:
+                body.append([float(x) for x in r])
+            except ValueError:
+                bad = next(x for x in r if not _is_float(x))
+                raise SystemDefinitionError(f"{path}: line {line}: {bad!r} is not a number") from None
+        if not body:
+            raise SystemDefinitionError(f"{path}: needs a header row and data rows")
+        data = np.array(body, dtype=float)
         found = {h: data[:, i] for i, h in enumerate(header)}
     elif suffix == ".npz":
-        with np.load(path) as z:
-            found = {k: z[k] for k in z.files}
+        try:
+            with np.load(path) as z:
+                found = {k: z[k] for k in z.files}
+        except (OSError, ValueError, EOFError) as exc:
+            raise SystemDefinitionError(f"{path}: not a readable .npz file ({exc})") from None
     elif suffix == ".mat":
         from scipy.io import loadmat
-        found = {k: v for k, v in loadmat(path).items() if not k.startswith("__")}
+        try:
+            found = {k: v for k, v in loadmat(path).items() if not k.startswith("__")}
+        except (OSError, ValueError, TypeError, NotImplementedError) as exc:
+            raise SystemDefinitionError(f"{path}: not a readable MATLAB file ({exc})") from None
     else:
         raise SystemDefinitionError(f"{path}: suffix {suffix!r} is not supported (use .csv, .npz or .mat)")
     return Measurement(**_pick(found, names, path), name=path.name)
+
+
+def _is_float(x: str) -> bool:
+    try:
+        float(x)
+        return True
+    except ValueError:
+        return False
 
 
 def save_csv(meas: Measurement, path) -> None:

@@ -1,21 +1,32 @@
 """Velocity and acceleration from quantized positions, and the force residual.
 
-Positions are differentiated with a Savitzky-Golay filter (local cubic least squares over
-``window`` seconds, zero phase); the drive force cm u + f_ext goes through the same smoothing
-(parallel filtering, as in inverse-dynamics identification) so both sides of the force balance
-have the same bandwidth: :meth:`Kinematics.filtered` is that filter, and the model's static maps
-(friction F(v), cogging F(q)) and the causes' regressors that are functions of v or q go through it
-too (unfiltered, the friction's jump at a velocity reversal stays sharp while the measured force's
-is smoothed over the window, and the residual shows a false low-speed friction dip); u is aligned
-for the zero-order hold of a digital controller. The residual of a model is
-r = force - m a - H_a[F(v) + F_cog(q)] - offset
-(and the first-order delay term)."""
+The force balance is formed sample by sample and then smoothed once. At sample k the
+instantaneous acceleration is the second difference a_k = (q_k+1 - 2 q_k + q_k-1) / dt^2 (for a
+zero-order-held drive exactly the mean of the forces held over the two neighbouring intervals, so
+the drive force at k is cm (u_k-1 + u_k) / 2 + f_ext), friction is the model's map at a
+short-window velocity ``vf`` (a Savitzky-Golay derivative over a third of the window: the map is
+nonlinear, and a map of a smoothed velocity is not a smoothed map), and every term then goes
+through one filter H_a, the low pass of the Savitzky-Golay second derivative over ``window``
+seconds (:meth:`Kinematics.filtered`). H_a applied to a_k is exactly that derivative of q (it is
+implemented as the derivative filter on the double sum), so the acceleration, the drive force and
+the model's forces share one bandwidth (parallel filtering, as in inverse-dynamics
+identification).
+
+Where the mass sticks (``slide`` false: the position stays within the sensor's resolution over
+a few milliseconds) friction carries whatever force is applied, up to the stick set: there the
+residual's integrand is the excess of that force over the model's stick set (zero when the stick
+holds), and a cause that changes a sliding force (an offset, a viscous term, cogging) changes
+nothing: its regressor is H_a[slide * x] (:meth:`Kinematics.sliding`). Without this, the
+filter's window straddling a stop mixes the model's F(0) = 0 into the sliding samples' residual.
+
+The residual of a model is r = H_a[g], g = drive(t - delay) - m a - offset - F_cog(q) - F(vf)
+- F_lag - F_flex while sliding, g = need - clip(need, stick set) while stuck (need = drive - offset - F_cog: at rest
+the acceleration is zero)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 from scipy.signal import savgol_filter
 
 from ..errors import SystemDefinitionError
@@ -24,38 +35,85 @@ from .data import Measurement
 
 @dataclass(frozen=True)
 class Kinematics:
-    """(n,) arrays: t [s], q [m] (smoothed), v [m/s], a [m/s^2], force [N] (cm u + f_ext,
-    smoothed), du [V/s] (du/dt, smoothed); cm : motor constant; window [s]; moving : samples with
-    |v| above v_min (where the static friction map is single-valued)."""
+    """(n,) arrays: t [s], q [m] (smoothed), v [m/s] (smoothed over the window), a [m/s^2]
+    (H_a of the instantaneous acceleration on sliding samples), force [N] (H_a of the drive force
+    cm u + f_ext); cm : motor constant; window [s]; moving : samples used for the force balance (|v| above v_min, away from
+    the filter edges and from stops and break-aways by half a window); vf [m/s] : short-window velocity for the friction maps; a_inst [m/s^2] :
+    second differences of q; drive [N] : cm u (aligned for the zero-order hold) + f_ext; slide :
+    bool, the mass slides (not stuck); resolution, noise [m] : the position sensor's step and
+    noise (standard deviation before quantization)."""
 
     t: np.ndarray
     q: np.ndarray
     v: np.ndarray
     a: np.ndarray
     force: np.ndarray
-    du: np.ndarray
     cm: float
     window: float
     moving: np.ndarray
+    vf: np.ndarray
+    a_inst: np.ndarray
+    drive: np.ndarray
+    slide: np.ndarray
+    resolution: float = 0.0
+    noise: float = 0.0
+
+    @property
+    def dt(self) -> float:
+        return float(self.t[1] - self.t[0])
 
     def filtered(self, x: np.ndarray) -> np.ndarray:
-        """x (n,) or (n, k) through the acceleration's filter (the one the force went through)."""
-        dt = float(self.t[1] - self.t[0])
-        return _acceleration_filter(np.asarray(x, dtype=float), dt, int(round(self.window / dt)))
+        """H_a x for x (n,) or (n, k): the filter the acceleration and the drive force went
+        through."""
+        return acceleration_filter(np.asarray(x, dtype=float), self.dt, int(round(self.window / self.dt)))
+
+    def sliding(self, x: np.ndarray) -> np.ndarray:
+        """H_a [slide x]: a force acting while the mass slides (absorbed by the stick force
+        otherwise), x (n,) or (n, k)."""
+        x = np.asarray(x, dtype=float)
+        s = self.slide if x.ndim == 1 else self.slide[:, None]
+        return self.filtered(np.where(s, x, 0.0))
 
 
-def _acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
-    """The low pass H_a of the SG second derivative (w samples, cubic) applied to x (n,) or to
-    each column of x (n, k): the derivative filter on x's double (trapezoidal) integral (it
-    annihilates the integration constants, so the result is exactly H_a x)."""
+def acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
+    """The low pass H_a of the Savitzky-Golay second derivative (w samples, cubic) applied to x
+    (n,) or to each column of x (n, k): the derivative filter on the double sum X of x
+    (X_k+1 - 2 X_k + X_k-1 = dt^2 x_k exactly, so H_a of the second differences of q is the
+    filter's second derivative of q)."""
     m = np.mean(x, axis=0)
-    x2 = cumulative_trapezoid(cumulative_trapezoid(x - m, dx=dt, axis=0, initial=0.0), dx=dt, axis=0, initial=0.0)
-    return savgol_filter(x2, w, 3, deriv=2, delta=dt, mode="interp", axis=0) + m
+    y = np.cumsum(x - m, axis=0) * dt
+    X = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(y, axis=0)[:-1]], axis=0) * dt
+    return savgol_filter(X, w, 3, deriv=2, delta=dt, mode="interp", axis=0) + m
 
 
-def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_min_frac: float = 0.02) -> Kinematics:
-    """Smoothed derivatives of a measurement (see the module docstring). window [s] defaults to
-    31 samples (31 ms at 1 kHz)."""
+def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.0, *,
+                  half_time: float = 0.001) -> np.ndarray:
+    """bool (n,): the position stays within one count of ``resolution`` [m] (plus four standard
+    deviations of the sensor ``noise`` [m]) over +-half_time [s] (at least 2 samples)."""
+    h = max(1, int(round(half_time / dt)))
+    tol = 1.01 * max(resolution, 0.0) + 4.0 * max(noise, 0.0) + 1e-15
+    n = q.size
+    if n <= 2 * h:
+        return np.zeros(n, bool)
+    from numpy.lib.stride_tricks import sliding_window_view
+    win = sliding_window_view(q, 2 * h + 1)
+    still = np.zeros(n, bool)
+    still[h:n - h] = (win.max(axis=1) - win.min(axis=1)) <= tol
+    return still
+
+
+def dilate(mask: np.ndarray, half: int) -> np.ndarray:
+    """bool (n,): samples within ``half`` samples of a true sample of ``mask``."""
+    c = np.concatenate([[0], np.cumsum(mask.astype(np.int64))])
+    j = np.arange(mask.size)
+    return (c[np.minimum(j + half + 1, mask.size)] - c[np.maximum(j - half, 0)]) > 0
+
+
+def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_min_frac: float = 0.02,
+               resolution: float | None = None, noise: float = 0.0) -> Kinematics:
+    """Smoothed derivatives of a measurement and the sliding samples (module docstring). window
+    [s] defaults to 31 samples (31 ms at 1 kHz); resolution [m] (default: read from the data)
+    and noise [m] of the position sensor decide which samples stick."""
     dt = meas.dt
     w = 31 if window is None else int(round(window / dt)) | 1
     if w < 5 or w > meas.n // 2:
@@ -63,27 +121,115 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     sg = dict(window_length=w, polyorder=3, mode="interp")
     q = savgol_filter(meas.q, deriv=0, **sg)
     v = savgol_filter(meas.q, deriv=1, delta=dt, **sg)
-    a = savgol_filter(meas.q, deriv=2, delta=dt, **sg)
-    # u_k is held over [t_k, t_k+1) (zero-order hold): the force acting around t_k is the mean of
-    # u_k-1 and u_k; without this half-sample alignment every sampled loop shows a 0.5 T "delay"
+    wf = max(5, (w // 3) | 1)
+    vf = savgol_filter(meas.q, wf, 3, deriv=1, delta=dt, mode="interp")
+    a_inst = np.zeros(meas.n)
+    a_inst[1:-1] = (meas.q[2:] - 2 * meas.q[1:-1] + meas.q[:-2]) / dt ** 2
+    # u_k is held over [t_k, t_k+1) (zero-order hold): the second difference at t_k sees the mean
+    # of u_k-1 and u_k; without this alignment every sampled loop shows a 0.5 T "delay"
     u_at = np.concatenate([[meas.u[0]], 0.5 * (meas.u[1:] + meas.u[:-1])])
-    # the force goes through the acceleration's own filter: the SG second derivative is
-    # d^2/dt^2 times a low-pass H_a(w) that attenuates more than SG smoothing does (0.80 against
-    # 0.97 at 18 Hz for 31 samples at 1 kHz), so smoothing the force would leave m (1 - H_a) a in
-    # the residual
-    force = _acceleration_filter(cm * u_at + meas.force_ext(), dt, w)
-    du = savgol_filter(meas.u, deriv=1, delta=dt, **sg)
+    drive = cm * u_at + meas.force_ext()
+    if resolution is None:
+        from .resimulate import resolution_of
+        resolution = resolution_of(meas.q)
+    slide = ~stuck_samples(meas.q, dt, resolution, noise)
+    H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
+    force = H(drive)
+    a = H(np.where(slide, a_inst, 0.0))
     moving = np.abs(v) > v_min_frac * np.max(np.abs(v))
     edge = np.zeros(meas.n, bool)
     edge[w:-w] = True                    # drop the filter's edge samples
-    return Kinematics(meas.t, q, v, a, force, du, float(cm), w * dt, moving & edge)
+    # a stop or a break-away inside the window: the stick classification and the friction map at
+    # a smoothed velocity are least certain there (the force jumps within a few samples)
+    change = np.zeros(meas.n, bool)
+    change[1:] = slide[1:] != slide[:-1]
+    moving &= edge & ~dilate(change, w // 2)
+    return Kinematics(meas.t, q, v, a, force, float(cm), w * dt, moving, vf, a_inst, drive, slide,
+                      float(resolution), float(noise))
+
+
+def reference_kinematics(meas: Measurement, model, *, window: float | None = None) -> Kinematics | None:
+    """Kinematics of an instrument trajectory, free of the sensor's and the actuator's noise: the
+    nominal closed loop re-simulated from the measured reference without sensor noise or
+    quantization (when the model has a controller; it follows the machine's tracking lag and
+    overshoot), else the reference itself with the model's inverse dynamics there as the drive
+    (m a_ref + F(v_ref) + offset + F_cog(q_ref)). None without a reference that moves."""
+    if meas.q_ref is None or np.ptp(meas.q_ref) <= 0:
+        return None
+    if model.controller is not None:
+        from .resimulate import resimulate
+        sim = resimulate(meas, model, resolution=0.0, sensor_noise=0.0)
+        if sim.ok:
+            return kinematics(Measurement(meas.t, sim.q, sim.u, name=meas.name + " (nominal loop)"), model.cm,
+                              window=window, resolution=0.0)
+    still = Measurement(meas.t, meas.q_ref, np.zeros(meas.n), name=meas.name + " (reference)")
+    k0 = kinematics(still, model.cm, window=window, resolution=0.0)
+    drive = model.mass * k0.a_inst + model.friction(k0.vf) + model.offset + model.cogging_force(meas.q_ref)
+    return kinematics(replace(still, u=drive / model.cm), model.cm, window=window, resolution=0.0)
+
+
+def acceleration_noise_psd(kin: Kinematics, f: np.ndarray) -> np.ndarray:
+    """One-sided power spectral density [(m/s^2)^2/Hz] at frequencies f [Hz] of the part of the
+    acceleration a that is the position sensor's noise: white noise of variance res^2/12 +
+    noise^2 through the Savitzky-Golay second derivative."""
+    dt = kin.dt
+    w = int(round(kin.window / dt))
+    imp = np.zeros(w)
+    imp[w // 2] = 1.0
+    h = savgol_filter(imp, w, 3, deriv=2, delta=dt, mode="constant")
+    H = np.abs(np.exp(-2j * np.pi * np.outer(f, np.arange(w)) * dt) @ h)
+    var = kin.resolution ** 2 / 12 + kin.noise ** 2
+    return 2 * var * dt * H ** 2
+
+
+def map_uncertain(kin: Kinematics, model, r: np.ndarray | None = None) -> np.ndarray:
+    """bool (n,): samples whose residual the friction map's own uncertainty could dominate. At
+    each sample the Stribeck level's slope |dg/dv| at vf times the velocity's uncertainty (the two
+    derivative filters' disagreement |vf - v| plus vf's quantization noise) bounds the force
+    error of evaluating the map at vf; a used sample is uncertain when that bound's mean over
+    the filter window around it exceeds the residual's robust spread on the used samples, or a
+    tenth of its RMS when an effect dominates it (a steep Stribeck dip crossed in a few
+    milliseconds, at break-away or a reversal)."""
+    from scipy.ndimage import uniform_filter1d
+    dt = kin.dt
+    w = int(round(kin.window / dt))
+    wf = max(5, (w // 3) | 1)
+    imp = np.zeros(wf)
+    imp[wf // 2] = 1.0
+    g1 = float(np.sqrt(np.sum(savgol_filter(imp, wf, 3, deriv=1, delta=dt, mode="constant") ** 2)))
+    sigma_v = np.sqrt(kin.resolution ** 2 / 12 + kin.noise ** 2) * g1
+    pos, neg = model.curve.positive, model.curve.negative
+    # the viscous part is linear: filtering it commutes with the map, its error does not grow
+    slope = np.abs(np.where(kin.vf >= 0, pos.level_slope(kin.vf), neg.level_slope(kin.vf)))
+    err = slope * (np.abs(kin.vf - kin.v) + sigma_v)
+    err = np.where(kin.slide, err, 0.0)
+    # the filter spreads a sample's error over its window: its mean there bounds the residual's
+    env = uniform_filter1d(err, 2 * (w // 2) + 1)
+    if r is None:
+        r = residual(kin, model)
+    used = kin.moving & np.isfinite(r)
+    if used.sum() < 10:
+        return np.zeros(kin.t.size, bool)
+    # the residual's noise (robust spread), or a tenth of its RMS when an effect dominates it
+    spread = max(1.4826 * float(np.median(np.abs(r[used] - np.median(r[used])))),
+                 0.1 * float(np.sqrt(np.mean(r[used] ** 2))))
+    return env > max(spread, 1e-300)
 
 
 def residual(kin: Kinematics, model) -> np.ndarray:
-    """Force residual r = force - delay cm u' - m a - offset - H_a[F(v) + F_cog(q)] - F_flex [N] of
-    a NominalModel (H_a : :meth:`Kinematics.filtered`) (the delay to first order: cm u(t - delay) ~ cm u(t) - delay cm u'(t))."""
-    r = (kin.force - model.delay * kin.cm * kin.du - model.mass * kin.a - model.offset
-         - kin.filtered(model.friction(kin.v) + model.lag_force(kin.v, kin.a) + model.cogging_force(kin.q)))
+    """Force residual r = H_a[g] [N] of a NominalModel (module docstring): the drive delayed by
+    the model's delay exactly (linear interpolation of the ZOH-aligned drive, exact for whole
+    samples; the first-order form cm u - delay cm u' left a residual that a resonance fitted on
+    noise-free records of loops with a two-sample delay)."""
+    s = kin.slide
+    cog = model.cogging_force(kin.q)
+    sliding = model.friction(kin.vf) + model.lag_force(kin.vf, kin.a_inst)
     if model.flexibility is not None:
-        r = r - model.flexibility.force(kin.a, float(kin.t[1] - kin.t[0]))
-    return r
+        sliding = sliding + model.flexibility.force(kin.a_inst, kin.dt)
+    drive = np.interp(kin.t - model.delay, kin.t, kin.drive) if model.delay > 0 else kin.drive
+    need = drive - model.offset - cog
+    grow = (model.dwell.level + model.dwell.gain) if model.dwell is not None else 0.0
+    stick_set = np.clip(need, -model.curve.negative.Fs - grow, model.curve.positive.Fs + grow)
+    # at rest the acceleration is zero (its second differences are the encoder's counts)
+    g = np.where(s, need - model.mass * kin.a_inst - sliding, need - stick_set)
+    return kin.filtered(g)

@@ -29,6 +29,34 @@ from ..errors import SystemDefinitionError, check_finite, check_finite_positive
 from ..models.friction import DirectionalCurve, LuGre, StribeckCurve
 from ..models.plant import COG_TABLE, Cogging
 
+SCHEMA_HELP = """\
+MODEL.json: the nominal model, a JSON object with the keys below (SI units; unknown keys are
+errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(q') - offset - F_cog(q).
+
+  "plant":      "mass" [kg] (required; the total moving mass), "motor_constant" cm [N per unit
+                of u] (default 1), "offset" [N], "delay" [s],
+                "cogging": [{"pitch": m, "cos": [N, ..], "sin": [N, ..]}]  (harmonics 1, 2, ..),
+                "flexibility": {"load_mass": kg, "frequency": Hz, "damping": ratio}
+  "friction":   "law": "coulomb-viscous" | "stribeck" | "switch" | "lugre";
+                "Fc" [N] (required), "Fs" [N], "vs" [m/s], "beta", "b" [N s/m];
+                "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg" for the negative direction;
+                "sigma0" [N/m], "sigma1" [N s/m] (lugre); "lag" [s];
+                "dwell": {"level": N, "gain": N, "time": s}
+  "controller": {"type": "pid", "kp", "kd", "ki"} (or "form": "PDI" with "P", "D", "I", or
+                "form": "K" with "K"), optional "derivative_on": "error" | "measurement",
+                "tau_f" [s], "sample_time" [s], "saturation", "output_resolution";
+                or {"type": "pd-velocity-loop", "kp" [1/s], "kv", "sample_time", "saturation"}
+                (u = kv (kp (q_ref - q) - v)). Needed for the behaviour view and for the
+                saturation, quantization and presliding causes.
+  "sensor":     {"resolution": m, "noise": m}  (encoder step; noise before quantization)
+  or a preset:  {"preset": "table9.1", "set": {"P": 60.0}}  (see: hunting models)
+
+Example (examples/emps/model.json, the EMPS benchmark's published model):
+  {"plant": {"mass": 95.1089, "motor_constant": 35.15065188},
+   "friction": {"law": "coulomb-viscous", "Fc": 20.3935, "b": 203.5034},
+   "controller": {"type": "pd-velocity-loop", "kp": 160.18, "kv": 243.45,
+                  "sample_time": 0.001, "saturation": 10.0}}
+"""
 LAWS = ("coulomb-viscous", "stribeck", "switch", "lugre")
 _FRICTION_KEYS = {"law", "Fc", "Fs", "vs", "beta", "b", "sigma0", "sigma1", "sigma2",
                   "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg", "lag", "dwell"}
@@ -79,14 +107,33 @@ class Dwell:
 
 def highpass_response(a: np.ndarray, dt: float, frequency: float, damping: float) -> np.ndarray:
     """H(s) a with H(s) = s^2 / (s^2 + 2 zeta w s + w^2), w = 2 pi frequency: causal, discretized
-    by the bilinear transform prewarped at w (exact gain and phase at the resonance)."""
-    from scipy.signal import bilinear, lfilter
+    by the bilinear transform s = K (1 - 1/z) / (1 + 1/z), K = 2 / dt, prewarped at w (exact gain and
+    phase at the resonance); a (n,) or (n, k) along axis 0."""
+    from scipy.signal import lfilter
     w = 2 * np.pi * frequency
-    fs = 1.0 / dt
-    # prewarping: design at the analog frequency that the bilinear map sends to w
-    wa = 2 * fs * np.tan(w / (2 * fs))
-    b, den = bilinear([1.0, 0.0, 0.0], [1.0, 2 * damping * wa, wa ** 2], fs)
-    return lfilter(b, den, np.asarray(a, dtype=float))
+    K = 2.0 / dt
+    wa = K * np.tan(w * dt / 2)          # the analog frequency the bilinear map sends to w
+    c = 2 * damping * wa * K
+    den = np.array([K * K + c + wa * wa, 2 * (wa * wa - K * K), K * K - c + wa * wa])
+    b = K * K * np.array([1.0, -2.0, 1.0])
+    return lfilter(b / den[0], den / den[0], np.asarray(a, dtype=float), axis=0)
+
+
+_NOMINAL_KEYS = {"preset", "set", "plant", "friction", "controller", "sensor"}
+# the keys of a model description (hunting.describe: states and equations), which diagnose cannot
+# map onto its fixed plant + friction law + controller structure
+_DESCRIPTION_KEYS = {"states", "equations", "signals", "parameters", "blocks"}
+_DESCRIPTION_NOT_NOMINAL = ("model file {path} is a model description (states and equations, the format of "
+                            "'hunting simulate --model'); diagnose takes a nominal model JSON with the keys plant, "
+                            "friction, controller, sensor (format in 'hunting diagnose --help', example: "
+                            "examples/emps/model.json)")
+
+
+def _looks_like_description(text: str) -> bool:
+    """Whether a file that is not JSON reads like a YAML model description (an 'equations:' or
+    'states:' key at the start of a line)."""
+    return any(line.split(":", 1)[0].strip() in _DESCRIPTION_KEYS for line in text.splitlines() if ":" in line
+               and not line.startswith((" ", "\t", "#")))
 
 
 @dataclass(frozen=True)
@@ -217,16 +264,26 @@ class NominalModel:
     def from_json(path) -> "NominalModel":
         path = Path(path)
         try:
-            d = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError) as exc:
-            raise SystemDefinitionError(f"model file {path}: {exc}") from None
+            text = path.read_text()
+        except OSError as exc:
+            raise SystemDefinitionError(f"model file {path}: {exc.strerror or exc}") from None
+        try:
+            d = json.loads(text)
+        except json.JSONDecodeError as exc:
+            if path.suffix.lower() in (".yaml", ".yml") or _looks_like_description(text):
+                raise SystemDefinitionError(_DESCRIPTION_NOT_NOMINAL.format(path=path)) from None
+            raise SystemDefinitionError(f"model file {path} is not JSON ({exc.msg} at line {exc.lineno} column "
+                                        f"{exc.colno}); diagnose takes a nominal model JSON, see 'hunting diagnose "
+                                        "--help' and examples/emps/model.json") from None
+        if isinstance(d, dict) and {"states", "equations"} & set(d):
+            raise SystemDefinitionError(_DESCRIPTION_NOT_NOMINAL.format(path=path))
         return NominalModel.from_dict(d)
 
     @staticmethod
     def from_dict(d: dict) -> "NominalModel":
         if not isinstance(d, dict):
             raise SystemDefinitionError(f"model = {d!r} must be a JSON object")
-        unknown = set(d) - {"preset", "set", "plant", "friction", "controller", "sensor"}
+        unknown = set(d) - _NOMINAL_KEYS
         if unknown:
             raise SystemDefinitionError(f"model: unknown keys {sorted(unknown)}; allowed: preset, set, plant, "
                                         "friction, controller, sensor")
@@ -329,10 +386,11 @@ def fit_coulomb_viscous(kin, *, v_min_frac: float = 0.02) -> tuple[NominalModel,
     """Symmetric Coulomb + viscous model without offset by least squares on the inverse dynamics
     (IDIM-LS): force = m a + H_a[Fc sign(v) + b v] on the samples with |v| > v_min_frac max|v|.
     kin : Kinematics. Returns (model, {"mass", "Fc", "b"} standard uncertainties)."""
-    sel = np.abs(kin.v) > v_min_frac * np.max(np.abs(kin.v))
-    Phi = np.column_stack([kin.a, kin.filtered(np.column_stack([np.sign(kin.v), kin.v]))])[sel]
-    theta, *_ = np.linalg.lstsq(Phi, kin.force[sel], rcond=None)
-    r = kin.force[sel] - Phi @ theta
+    sel = kin.moving & (np.abs(kin.v) > v_min_frac * np.max(np.abs(kin.v)))
+    Phi = np.column_stack([kin.a, kin.sliding(np.column_stack([np.sign(kin.vf), kin.vf]))])[sel]
+    y = kin.sliding(kin.drive)[sel]
+    theta, *_ = np.linalg.lstsq(Phi, y, rcond=None)
+    r = y - Phi @ theta
     s2 = float(r @ r) / max(sel.sum() - 3, 1)
     sd = np.sqrt(np.diag(np.linalg.inv(Phi.T @ Phi)) * s2)
     m, Fc, b = map(float, theta)

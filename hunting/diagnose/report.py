@@ -8,11 +8,125 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import _plt, cobweb_path, save
+from .causes import CAUSES
+from .causes._words import _pct, _q
 from .select import Diagnosis
 
 
-def _pm(sigma) -> str:
-    return "" if sigma is None or not np.isfinite(sigma) else f" ± {sigma:.2g}"
+def parameter_text(name: str, parameters: dict, sigma: dict | None = None) -> str:
+    """'offset = -126.5 ± 0.4 mN, ...': a cause's parameters with units and uncertainties."""
+    units = getattr(CAUSES[name], "UNITS", {})
+    sigma = sigma or {}
+    return ", ".join(f"{k} = {_q(v, sigma.get(k), units.get(k, ''))}" for k, v in parameters.items()
+                     if isinstance(v, (int, float)))
+
+
+def finding(dg: Diagnosis, cause) -> str:
+    """One plain sentence: what the simulation gets wrong, as the cause reads it."""
+    mod = CAUSES[cause.name]
+    base = dg.model
+    try:
+        return mod.sentence(cause.parameters, cause.increments, base)
+    except (KeyError, ZeroDivisionError, TypeError, ValueError):
+        return mod.DESCRIPTION
+
+
+def _metric_value(metric: str, x, unit: str | None = None) -> str:
+    """A metric's value with its unit (given, or read from a '[unit]' in the metric's name)."""
+    if isinstance(x, (bool, np.bool_)):
+        return "yes" if x else "no"
+    if x is None:
+        return "-"
+    if unit is None:
+        unit = metric[metric.rfind("[") + 1:metric.rfind("]")] if "[" in metric else ""
+    return _q(x, None, unit)
+
+
+def _p_text(p) -> str:
+    return "-" if p is None else ("p < 1e-16" if p < 1e-16 else f"p = {p:.2g}")
+
+
+def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
+    """The diagnosis as the ``hunting diagnose`` command prints it: what the simulation gets
+    wrong (one sentence per finding), each cause's final parameters with units and standard
+    uncertainties and its validation gain, the validation metrics nominal against extended, the
+    alternatives, the rejected and the untested causes with their reasons, and the rule."""
+    import textwrap
+
+    def wrap(text, indent="  ", sub="    "):
+        return textwrap.fill(text, width=width, initial_indent=indent, subsequent_indent=sub)
+    out = []
+    if dg.causes:
+        out.append(f"What the simulation gets wrong ({len(dg.causes)} cause{'s' if len(dg.causes) > 1 else ''}, "
+                   "most important first):")
+        for i, c in enumerate(dg.causes, 1):
+            out.append(wrap(f"{i}. {c.name}: {finding(dg, c)}.", "  ", "     "))
+            out.append(wrap(f"parameters: {parameter_text(c.name, c.parameters, c.sigma)}", "     ", "       "))
+            g = c.gain
+            rel = 1 - g["extended"] / g["nominal"] if g["nominal"] else 0.0
+            label = g["metric"].split(" [")[0]
+            out.append(wrap(f"evidence: {_p_text(c.p_value)}; {label}: {_metric_value(g['metric'], g['nominal'])} "
+                            f"without it -> {_metric_value(g['metric'], g['extended'])} with it ({_pct(rel)} lower)",
+                            "     ", "       "))
+    else:
+        what = ("no cause found: the nominal model explains the data within the rule"
+                if dg.nominal is not None or dg.behaviour else "no cause could be tested on these data")
+        out.append(what + ".")
+    rows = []
+    for g in dg.gains():
+        label = g["metric"] if "measured" not in g else (
+            f"{g['metric'].split(':')[0]} (measured {_metric_value('', g['measured'], g['unit'])}): error")
+        rows.append((label, _metric_value("", g["nominal"], g["unit"]), _metric_value("", g["extended"], g["unit"])))
+    if rows:
+        out.append("")
+        out.append("Validation data, nominal -> extended model:")
+        w0 = max(len(r[0]) for r in rows)
+        for m, a, b in rows:
+            out.append(f"  {m:<{w0}}  {a:>10} -> {b}")
+    if dg.alternatives:
+        out.append("")
+        out.append("Alternatives (other readings of the same data):")
+        for a in dg.alternatives:
+            how = (f"in place of {a['replaces']}" if a.get("kind") == "same family"
+                   else "alone; adds nothing once {} {} in".format(", ".join(a.get("absorbed_by", [])) or "the causes",
+                                                                      "is" if len(a.get("absorbed_by", [])) == 1 else "are"))
+            g = a["gain"]
+            out.append(wrap(f"{a['name']} ({how}): {parameter_text(a['name'], a['parameters'])}; validation force "
+                            f"residual {_q(g['extended'], None, 'N')}, BIC {a['bic_difference']:+.1f}"))
+    if dg.explanations:
+        out.append(wrap("Other explanations searched (BIC on the fitting data against the selected one; negative: "
+                        "fits the fitting data better, but not all of its causes held on the validation data): "
+                        + "; ".join(f"{{{', '.join(e['causes']) or 'nominal model'}}} {e['bic_difference']:+.1f}, "
+                                    f"validation residual {_q(e['validation_rms'], None, 'N')}"
+                                    for e in dg.explanations), "", "  "))
+    if dg.rejected:
+        out.append("")
+        out.append("Tested and rejected:")
+        for r in dg.rejected:
+            out.append(wrap(f"{r['name']}: {_reason(r)}"))
+    if dg.untested:
+        out.append("")
+        out.append("Not tested on these data:")
+        for u in dg.untested:
+            out.append(wrap(f"{u['name']}: {u['reason']}"))
+    if dg.notes:
+        out.append("")
+        out.extend(wrap(f"note: {n}", "", "  ") for n in dg.notes)
+    out.append("")
+    out.append(wrap(f"Rule: {dg.criterion}.", "", "  "))
+    return "\n".join(out)
+
+
+def _reason(r: dict) -> str:
+    if r.get("reason"):
+        return r["reason"]
+    p, g = r.get("p_value"), r.get("validation_gain")
+    parts = []
+    if p is not None:
+        parts.append(f"p = {p:.2g}")
+    if g is not None:
+        parts.append(f"validation gain {g:.1%}")
+    return ", ".join(parts) or "did not pass the rule"
 
 
 def write_json(dg: Diagnosis, path) -> None:
@@ -124,29 +238,34 @@ def write_report(dg: Diagnosis, directory) -> Path:
         if any(dg.behaviour[k]["event_map"] for k in ("measured", "nominal", "extended")):
             event_map_figure(dg, d / "event_map.png")
             imgs.append("event_map.png")
-    gains = "".join(f"<tr><td>{html.escape(g['metric'])}</td><td>{g['nominal']}</td><td>{g['extended']}</td></tr>"
-                    for g in dg.gains())
+    gains = "".join(f"<tr><td>{html.escape(g['metric'])}</td><td>{html.escape(_metric_value('', g.get('measured'), g['unit']))}"
+                    f"</td><td>{html.escape(_metric_value('', g['nominal'], g['unit']))}</td>"
+                    f"<td>{html.escape(_metric_value('', g['extended'], g['unit']))}</td></tr>" for g in dg.gains())
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in dg.notes)
     rows = "".join(
-        f"<tr><td>{i + 1}</td><td>{html.escape(c.name)}</td><td>{c.score:.3g}</td><td>{c.p_value:.2g}</td>"
-        f"<td>{html.escape(', '.join(f'{k} = {v:.4g}' + _pm(c.sigma.get(k)) for k, v in c.parameters.items()))}</td>"
+        f"<tr><td>{i + 1}</td><td>{html.escape(c.name)}</td><td>{c.score:.3g}</td><td>{html.escape(_p_text(c.p_value))}</td>"
+        f"<td>{html.escape(parameter_text(c.name, c.parameters, c.sigma))}</td>"
         f"<td>{html.escape(c.gain['metric'])}: {c.gain['nominal']:.4g} → {c.gain['extended']:.4g}</td></tr>"
         for i, c in enumerate(dg.causes))
-    rej = "".join(f"<li>{html.escape(r['name'])}: " + html.escape(
-        r.get("reason") or f"p = {r.get('p_value', float('nan')):.2g}, validation gain = "
-        f"{r.get('validation_gain') if r.get('validation_gain') is None else format(r['validation_gain'], '.2%')}")
-        + "</li>" for r in dg.rejected)
-    alt = "".join(f"<li>{html.escape(a['name'])}: {html.escape(str(a['parameters']))} (absorbed by "
-                  f"{html.escape(', '.join(a['absorbed_by']))})</li>" for a in dg.alternatives)
+    rej = "".join(f"<li>{html.escape(r['name'])}: {html.escape(_reason(r))}</li>" for r in dg.rejected)
+    unt = "".join(f"<li>{html.escape(u['name'])}: {html.escape(u['reason'])}</li>" for u in dg.untested)
+    alt = "".join(f"<li>{html.escape(a['name'])} ("
+                  + html.escape(f"in place of {a['replaces']}" if a.get("kind") == "same family"
+                                else "alone, absorbed by " + ", ".join(a.get("absorbed_by", [])))
+                  + f"): {html.escape(parameter_text(a['name'], a['parameters']))}; BIC {a['bic_difference']:+.1f}</li>"
+                  for a in dg.alternatives)
+    finds = "".join(f"<li>{html.escape(c.name)}: {html.escape(finding(dg, c))}</li>" for c in dg.causes)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>hunting diagnosis</title></head><body>
 <h1>Diagnosis</h1>
-<table border="1" cellpadding="4"><tr><th>validation metric</th><th>nominal</th><th>extended</th></tr>{gains}</table>
+<table border="1" cellpadding="4"><tr><th>validation metric</th><th>measured</th><th>nominal</th><th>extended</th></tr>{gains}</table>
 {'<ul>' + notes + '</ul>' if notes else ''}
-<p>Criterion: {html.escape(dg.criterion)}.</p>
+<p>Rule: {html.escape(dg.criterion)}.</p>
 <table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
 <th>validation metric: nominal → extended</th></tr>{rows}</table>
+{'<ul>' + finds + '</ul>' if finds else '<p>No cause found: the nominal model explains the data within the rule.</p>'}
 {'<h2>Alternatives</h2><ul>' + alt + '</ul>' if alt else ''}
-{'<h2>Not reported (why)</h2><ul>' + rej + '</ul>' if rej else ''}
+{'<h2>Tested and rejected (why)</h2><ul>' + rej + '</ul>' if rej else ''}
+{'<h2>Not tested on these data (why)</h2><ul>' + unt + '</ul>' if unt else ''}
 {''.join(f'<img src="{i}" width="720"><br>' for i in imgs)}</body></html>"""
     (d / "index.html").write_text(page)
     return d / "index.html"

@@ -114,7 +114,7 @@ class SampledController:
                          self.saturation, float(hold), self.output_resolution])
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy")
 def _cog(q, cog, bases):
     out = 0.0
     for b in bases:
@@ -122,7 +122,7 @@ def _cog(q, cog, bases):
     return out
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy")
 def _rates(q, v, z, s, fa, p, cog, bases):
     """(q', v', z') at applied force fa (cm u + f_ext - offset), direction s for the curve. z is
     LuGre's bristle deflection, or for a static law with frictional memory (lag p[16] > 0) the
@@ -138,7 +138,7 @@ def _rates(q, v, z, s, fa, p, cog, bases):
     return v, (fd - s * g - p[base + 4] * v) / p[0], 0.0
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, error_model="numpy")
 def _rk4(q, v, z, s, fa, h, p, cog, bases):
     """One classical RK4 step of length h with the friction direction s held."""
     a1, b1, c1 = _rates(q, v, z, s, fa, p, cog, bases)

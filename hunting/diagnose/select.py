@@ -1,24 +1,33 @@
-"""Which causes explain a model-data mismatch: forward selection on the force residual that does
-not fool itself.
+"""Which causes explain a model-data mismatch, judged so that clean data gives none.
 
-Criterion (stated in every report): a cause is added when (1) its extension, fitted by least
-squares on the fitting data, reduces the residual sum of squares there significantly (F test,
-p < alpha, with the degrees of freedom reduced to the effective number of independent samples
-n (1 - rho1) / (1 + rho1), rho1 the lag-1 autocorrelation of the extended model's residual,
-because smoothed residuals are far from white), and (2) it lowers the RMS residual on the validation data by at
-least ``min_gain`` (relative). Hyper-parameters (a cogging pitch, a Stribeck velocity) are chosen
-on the fitting data only. Causes are ranked by their score: how much the validation metric grows
-when each is dropped from the final extended model (force channel), or nominal / extended - 1 of
-the cause's own validation metric (other channels).
+The rule (stated in every report, :data:`RULE`):
 
-Causes with their own evidence (``CHANNEL = "own"``: dwell, saturation, quantization) bring a
-statistic with its p-value and a validation metric of their own (module docstrings); the same
-alpha and min_gain decide.
+- force channel (offset, asymmetry, cogging, stribeck, viscous, mass, delay, flexibility, lag,
+  reversal): explanations, sets of at most ``max_causes`` causes, are searched by BIC on the
+  fitting data's force residual, thinned and prewhitened by an AR noise model fitted on the
+  residual of every candidate at once; a cause of the best explanation is kept when it explains
+  the validation residual of the others out of sample (one-sided test, prewhitened, with an
+  autocorrelation- and level-consistent standard error: p < alpha; when the reference moves,
+  also its prediction along the reference trajectory, p < alpha_reference: feedback puts the
+  sensor's and the actuator's noise into the measured regressors, not into the reference's),
+  dropping it grows the validation RMS by at least ``min_gain``, and the whole set beats each of
+  its subsets by as much; what fails is removed and the rest refitted
+  (:mod:`hunting.diagnose.force`, :mod:`hunting.diagnose.stats`);
+- causes with their own evidence (``CHANNEL = "own"``: dwell, saturation, quantization) bring a
+  statistic with its p-value and a validation metric of their own (module docstrings); the same
+  alpha and min_gain decide;
+- stick-channel causes (``CHANNEL = "stick"``: presliding) are judged on the samples where the
+  (force-extended) model says the mass sticks: a chi-square test of the motion there against the
+  sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
+  the re-simulated position error (controller known) or in the stick-segment displacement.
+  Presliding and reversal are one family (LuGre bristles): when the force channel found
+  reversal, presliding is not tested again.
 
-Stick-channel causes (``CHANNEL = "stick"``, e.g. presliding) are judged on the samples where the
-(force-extended) model says the mass sticks: a chi-square test of the motion there against the
-sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
-the re-simulated position error (controller known) or in the stick-segment displacement.
+Causes are ranked by their score: how much the validation metric grows when each is dropped
+from the final extended model (force channel), or nominal / extended - 1 of the cause's own
+validation metric (other channels). Each reports the final values of its parameters, the values
+the extended model holds, with standard uncertainties; the change against the nominal model is
+an extra field (``increments``).
 
 The behaviour view (when the model has a controller and the data a reference): the validation run
 re-simulated with the nominal and the extended model, compared with the measurement
@@ -28,24 +37,31 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import stats
 
 from ..errors import SystemDefinitionError
 from .causes import CAUSES
 from .data import Measurement
-from .kinematics import Kinematics, kinematics, residual
+from .kinematics import Kinematics, kinematics, map_uncertain, reference_kinematics
 from .model import NominalModel
 
-CRITERION = ("F test on the fitting data (p < {alpha:g}, effective sample size from the residual's lag-1 "
-             "autocorrelation) and a validation RMS reduction of at least {min_gain:.0%}")
+RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
+        "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once; each "
+        "of its causes kept when it explains the validation residual of the others out of sample (one-sided test, "
+        "prewhitened, autocorrelation-consistent standard error, p < {alpha:g}; with a moving reference its prediction "
+        "along the reference too, p < {alpha_reference:g}), dropping it grows the validation RMS by at least "
+        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), and the set beats each of its subsets by as much; other channels: their own statistic at "
+        "p < {alpha:g} and a validation gain of at least {min_gain:.0%}")
+CRITERION = RULE
 
 
 @dataclass(frozen=True)
 class Cause:
-    """One reported cause: name; score (relative growth of the validation RMS when it is dropped
-    from the extended model); statistic (F) and p_value on the fitting data when it was added;
-    parameters and their standard uncertainties; gain: validation force-residual RMS [N] of the
-    model before and after adding it."""
+    """One reported cause: name; score (relative growth of the validation metric when it is
+    dropped from the extended model); statistic and p_value of the test that admitted it;
+    parameters : final values (those the extended model holds) and sigma their standard
+    uncertainties (None where not estimated); gain : the validation metric of the model without
+    and with it; increments : parameters' change against the nominal model; family : causes that
+    share a signature share it; hyper : the hyper-parameter variant; theta : fitted coefficients."""
 
     name: str
     score: float
@@ -56,10 +72,13 @@ class Cause:
     gain: dict
     hyper: dict = field(default_factory=dict)
     theta: np.ndarray | None = None
+    increments: dict = field(default_factory=dict)
+    family: str = ""
 
     def as_dict(self) -> dict:
         return dict(name=self.name, score=self.score, statistic=self.statistic, p_value=self.p_value,
-                    parameters=self.parameters, sigma=self.sigma, gain=self.gain, role="selected")
+                    parameters=self.parameters, sigma=self.sigma, increments=self.increments, gain=self.gain,
+                    family=self.family or self.name, description=CAUSES[self.name].DESCRIPTION, role="selected")
 
 
 @dataclass
@@ -68,13 +87,15 @@ class Diagnosis:
     extended : validation force-residual RMS [N] (None when the force channel was skipped);
     criterion : the selection rule; kin_fit, kin_val : kinematics; r_* : residuals (n,) of the
     nominal and extended model on both sets (NaN where not used: |v| small or filter edges);
-    rejected : candidates that failed the criterion at the step where selection stopped;
-    alternatives : causes that pass the criterion on their own but add nothing once the selected
-    ones are in (their stand-alone parameters and gain: e.g. a constant offset that a
-    direction-dependent viscous term explains as well); extended_model : the nominal model with
-    every selected extension; behaviour : the behaviour view on the validation data (None without
-    a controller or a reference); notes : what was skipped and why; validation : the validation
-    Measurement used; simulations : the behaviour view's re-simulations {"nominal", "extended"}."""
+    rejected : candidates that failed the rule (with the reason); alternatives : other readings
+    of the data (a cause of the same family that would replace a selected one, or a cause that
+    explains the data alone but adds nothing once the selected ones are in), each with its
+    parameters, validation gain and BIC difference; explanations : the runner-up sets of the
+    force channel's search with their BIC difference and validation RMS; untested : causes this
+    record cannot test, with the reason; extended_model : the nominal model with every selected
+    extension; behaviour : the behaviour view on the validation data (None without a controller
+    or a reference); notes : what was skipped and why; validation : the validation Measurement
+    used; simulations : the behaviour view's re-simulations {"nominal", "extended"}."""
 
     causes: list
     nominal: float | None
@@ -93,122 +114,139 @@ class Diagnosis:
     notes: list = field(default_factory=list)
     validation: Measurement | None = None
     simulations: dict | None = None
+    untested: list = field(default_factory=list)
+    explanations: list = field(default_factory=list)
 
     def gains(self) -> list:
-        """Validation metrics of the nominal against the extended model: force residual RMS [N],
-        and from the behaviour view position and drive-force RMS errors of the re-simulation,
-        stick-error, cycle-amplitude, cycle-period and event-map-contraction errors against the
-        measurement."""
+        """Validation metrics of the nominal against the extended model, rows {metric, unit,
+        nominal, extended} and for behaviour metrics the measured value (errors are against it):
+        force residual RMS, and from the behaviour view the re-simulation's position and
+        drive-force RMS errors, stick error, cycle amplitude and period, final error, event-map
+        contraction, whether the loop ends at rest (rows the runs do not have are left out)."""
         out = []
         if self.nominal is not None:
-            out.append(dict(metric="force residual RMS [N]", nominal=self.nominal, extended=self.extended))
+            out.append(dict(metric="force residual RMS", unit="N", nominal=self.nominal, extended=self.extended))
         b = self.behaviour
         if b:
-            for key, label in (("position_rms", "re-simulated position RMS error [m]"),
-                               ("force_rms", "re-simulated drive force RMS error [N]")):
-                out.append(dict(metric=label, nominal=b["nominal"][key], extended=b["extended"][key]))
-            for key, label in (("stick_error", "stick error RMS [m]"), ("cycle_amplitude", "cycle amplitude [m]"),
-                               ("cycle_period", "cycle period [s]"), ("final_error", "final error [m]"),
-                               ("map_contraction", "event map contraction |d_n+1| / |d_n|")):
+            for key, label, unit in (("position_rms", "re-simulated position RMS error", "m"),
+                                     ("force_rms", "re-simulated drive force RMS error", "N")):
+                out.append(dict(metric=label, unit=unit, nominal=b["nominal"][key], extended=b["extended"][key]))
+            for key, label, unit in (("stick_error", "stick error RMS", "m"), ("cycle_amplitude", "cycle amplitude", "m"),
+                                     ("cycle_period", "cycle period", "s"), ("final_error", "final error", "m"),
+                                     ("map_contraction", "event map contraction |d_n+1| / |d_n|", "")):
                 m = b["measured"][key]
-                if m is None:
+                if m is None or b["nominal"].get(key) is None or b["extended"].get(key) is None:
                     continue
-                err = [None if b[k][key] is None else abs(b[k][key] - m) for k in ("nominal", "extended")]
-                out.append(dict(metric=f"|{label} - measured {m:.4g}|", nominal=err[0], extended=err[1]))
-            out.append(dict(metric="ends at rest (measured: {})".format(b["measured"]["at_rest"]),
-                            nominal=b["nominal"]["at_rest"], extended=b["extended"]["at_rest"]))
+                err = [abs(b[k][key] - m) for k in ("nominal", "extended")]
+                out.append(dict(metric=f"{label}: error against the measured", unit=unit, measured=m, nominal=err[0],
+                                extended=err[1]))
+            if None not in (b["measured"].get("at_rest"), b["nominal"].get("at_rest"), b["extended"].get("at_rest")):
+                out.append(dict(metric="ends at rest", unit="", measured=b["measured"]["at_rest"],
+                                nominal=b["nominal"]["at_rest"], extended=b["extended"]["at_rest"]))
         return out
 
     def as_dict(self) -> dict:
-        alts = [dict(name=a["name"], score=0.0, parameters=a["parameters"], gain=a["gain"], role="alternative",
-                     absorbed_by=a["absorbed_by"]) for a in self.alternatives]
+        alts = [dict(a, score=0.0, role="alternative") for a in self.alternatives]
         return dict(causes=[c.as_dict() for c in self.causes] + alts,
                     gain=dict(metric="force residual RMS [N] on the validation data", nominal=self.nominal,
                               extended=self.extended),
                     gains=self.gains(), behaviour=self.behaviour, notes=self.notes,
-                    criterion=self.criterion, rejected=self.rejected, alternatives=self.alternatives,
+                    criterion=self.criterion, rule=self.criterion, rejected=self.rejected,
+                    alternatives=self.alternatives, explanations=self.explanations, untested=self.untested,
                     nominal_model=self.model.to_dict(),
                     extended_model=None if self.extended_model is None else self.extended_model.to_dict())
 
 
-def _rms(r) -> float:
-    return float(np.sqrt(np.mean(r ** 2)))
-
-
-def _n_eff(r: np.ndarray) -> float:
-    r = r - r.mean()
-    rho = float(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300))
-    rho = min(max(rho, 0.0), 0.999)
-    return r.size * (1 - rho) / (1 + rho)
-
-
-def _designs(name, kin_f, kin_v, model, mf, mv):
-    """(Phi_fit, Phi_val, hyper, shift_fit, shift_val) per hyper-parameter variant of a cause, on
-    the used samples; shift is the known, unfitted part of the extension's force change (the
-    cause's optional ``shift``; zeros without one)."""
-    mod = CAUSES[name]
-    shift = getattr(mod, "shift", None)
-    for hyper in mod.hypers(kin_f, model):
-        sf = shift(kin_f, model, hyper)[mf] if shift else np.zeros(int(mf.sum()))
-        sv = shift(kin_v, model, hyper)[mv] if shift else np.zeros(int(mv.sum()))
-        yield mod.design(kin_f, model, hyper)[mf], mod.design(kin_v, model, hyper)[mv], hyper, sf, sv
-
-
 def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
-             max_causes: int = 4, min_gain: float = 0.02, alpha: float = 1e-3, window: float | None = None,
-             behaviour: bool = True) -> Diagnosis:
+             max_causes: int = 3, min_gain: float = 0.05, alpha: float = 1e-3, alpha_reference: float = 0.01,
+             window: float | None = None, behaviour: bool = True, progress=None) -> Diagnosis:
     """Rank the causes of the mismatch between the model and the measured data.
 
     fit : data to fit extensions on; validate : data to judge them on (default: the last 40 % of
     ``fit``, the first 60 % being used for fitting); causes : names to consider (default all);
-    max_causes : bound on the force-channel selection; min_gain, alpha : the criterion (module
-    docstring); behaviour : re-simulate the validation run (needs a controller and q_ref)."""
+    max_causes : the largest set of force-channel causes searched; min_gain, alpha,
+    alpha_reference : the rule (module docstring); window [s] : the smoothing window (default
+    :func:`default_window`); behaviour : re-simulate the validation run (needs a controller and
+    q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
+    the work advances (the CLI draws a bar with it)."""
+    from .force import Library, select
+    from .guards import check_inputs, check_units
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
         raise SystemDefinitionError(f"causes {bad} are not known: use {sorted(CAUSES)}")
+    tick = _Progress(progress, 2 + sum(getattr(CAUSES[n], "CHANNEL", "force") != "force" for n in names))
+    if not (isinstance(max_causes, (int, np.integer)) and 1 <= max_causes <= 4):
+        raise SystemDefinitionError(f"max_causes = {max_causes!r} must be an integer in [1, 4]")
     if validate is None:
+        if fit.n < 250:
+            raise SystemDefinitionError(f"{fit.name}: {fit.n} samples are too few to split into fitting and validation "
+                                        "parts (need >= 250, or give validation data)")
         t_split = fit.t[0] + 0.6 * (fit.t[-1] - fit.t[0])
         fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
-    kf = kinematics(fit, model.cm, window=window)
-    kv = kinematics(validate, model.cm, window=window)
-    crit = CRITERION.format(alpha=alpha, min_gain=min_gain)
+    notes: list = list(check_inputs(fit, validate, model))
+    if window is None:
+        window = default_window(fit, validate, model)
+    sensor = dict(resolution=model.resolution, noise=model.sensor_noise)
+    kf = kinematics(fit, model.cm, window=window, **sensor)
+    kv = kinematics(validate, model.cm, window=window, **sensor)
+    check_units(kf, model, fit.name)
+    check_units(kv, model, validate.name)
+    crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
-    notes: list = []
     nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
-    # sliding samples: |v| above 2 % of the maximum and above the model's stick speed (creep in
-    # presliding is not sliding)
-    kf = replace(kf, moving=kf.moving & (np.abs(kf.v) > model.v_stick()))
-    kv = replace(kv, moving=kv.moving & (np.abs(kv.v) > model.v_stick()))
-    if kf.moving.sum() >= 50 and kv.moving.sum() >= 50:
-        fc = _force_channel(force_names, kf, kv, model, max_causes, min_gain, alpha)
+    kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
+    untested: list = []
+    tick("force channel")
+    if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100:
+        step = max(1, int(round(kf.window / fit.dt)) // 3)
+        kr = reference_kinematics(validate, model, window=window)
+        lib = Library(force_names, kf, kv, model, kf.moving, kv.moving, step, kr)
+        untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
+        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference))
     else:
-        notes.append("force channel skipped: fewer than 50 sliding samples (|v| > 2 % of the maximum and > the "
-                     f"model's stick speed {model.v_stick():.3g} m/s) in the fitting or validation data")
-        fc = dict(causes=[], nominal=None, extended=None, rejected=[], alternatives=[], model=model,
+        if force_names:
+            why = ("fewer than 100 sliding samples (|v| > 2 % of the maximum, half a filter window from stops and "
+                   "where the friction map is not too steep to evaluate) in the fitting or validation data")
+            notes.append(f"force channel skipped: {why}")
+            untested += [dict(name=n, reason=why) for n in force_names]
+        fc = dict(causes=[], nominal=None, extended=None, rejected=[], alternatives=[], explanations=[], model=model,
                   r_fit=nan_f, r_val_nom=nan_v, r_val_ext=nan_v)
     ext = fc["model"]
     result, rejected = list(fc["causes"]), list(fc["rejected"])
     can_sim = model.controller is not None and validate.q_ref is not None and fit.q_ref is not None
     for name in stick_names:
+        tick(name)
         if ext.law == "lugre" and model.law != "lugre":
-            rejected.append(dict(name=name, step="stick", statistic=None, p_value=None, validation_gain=None,
-                                 reason="the force channel's extension already has LuGre presliding (reversal)"))
+            untested.append(dict(name=name, reason="reported as reversal: the force channel's extension already has "
+                                                   "LuGre bristles (one family)"))
+            continue
+        if model.law == "lugre":
+            untested.append(dict(name=name, reason="the nominal model has LuGre bristles already"))
+            continue
+        if ext.lag > 0:
+            untested.append(dict(name=name, reason="the force channel found frictional memory (lag), which LuGre "
+                                                   "bristles would replace"))
             continue
         cause, row, ext = _stick_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim)
         if cause is not None:
             result.append(cause)
         elif row is not None:
             rejected.append(row)
+        else:
+            untested.append(dict(name=name, reason="fewer than 200 samples where the model sticks"))
     if own_names:
         from .resimulate import resolution_of
         res = model.resolution if model.resolution is not None else resolution_of(fit.q)
         for name in own_names:
+            tick(name)
             cause, row, ext = _own_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim, res)
             if cause is not None:
                 result.append(cause)
+            elif row.get("untested"):
+                untested.append(dict(name=name, reason=row["reason"]))
             else:
                 rejected.append(row)
     # one ranking over the channels: the relative worsening of each cause's own validation metric
@@ -216,6 +254,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     result.sort(key=lambda c: -c.score)
     view, sims = None, None
     if behaviour and model.controller is not None and validate.q_ref is not None:
+        tick("behaviour view")
         from .behaviour import compare
         from .resimulate import resimulate, resolution_of
         res = model.resolution if model.resolution is not None else resolution_of(validate.q)
@@ -223,127 +262,164 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         view = compare(validate, sims, model.cm, res)
     elif behaviour:
         notes.append("behaviour view skipped: it needs the model's 'controller' and the reference q_ref in the data")
+    tick("done")
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
-                     fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims)
+                     fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
+                     fc["explanations"])
 
 
-def _force_channel(names, kf, kv, model, max_causes, min_gain, alpha) -> dict:
-    """Forward selection on the force residual (module docstring); returns the selected causes,
-    the extended model and the residuals."""
-    mf, mv = kf.moving, kv.moving
-    rf0 = residual(kf, model)[mf]
-    rv0 = residual(kv, model)[mv]
-    # chosen: (name, Phi_f, Phi_v, hyper, F, p, rms_before, rms_after, gain, shift_f, shift_v);
-    # the extended model's force change is Pf theta + Sf (Sf: the chosen causes' known shifts)
-    chosen: list = []
-    Pf = np.zeros((rf0.size, 0))
-    Pv = np.zeros((rv0.size, 0))
-    Sf, Sv = np.zeros(rf0.size), np.zeros(rv0.size)
-    rejected = []
-    alone: dict = {}                       # step-1 fits that pass the criterion on their own
-    for _ in range(max_causes):
-        th, *_ = np.linalg.lstsq(Pf, rf0 - Sf, rcond=None) if Pf.shape[1] else (np.zeros(0),)
-        rf_cur = rf0 - Sf - Pf @ th
-        rv_cur = rv0 - Sv - Pv @ th
-        ss0 = float(rf_cur @ rf_cur)
-        best = None
-        for name in names:
-            if any(c[0] == name for c in chosen):
+WINDOW_CYCLES = 0.5      # the smoothing window, in periods of the loop's bandwidth (at least 31 samples)
+
+
+def default_window(fit: Measurement, validate: Measurement, model: NominalModel) -> float:
+    """The smoothing window [s]: 31 samples, or half a period of the loop's bandwidth when that is
+    longer (fast sampling: the acceleration's noise falls as the fifth power of the window, and
+    with it what feedback of that noise puts into the regressors), at most a quarter of the
+    shorter record."""
+    from .guards import loop_bandwidth
+    dt = fit.dt
+    f_bw = loop_bandwidth(model)
+    w = 31 * dt if not f_bw else max(31 * dt, WINDOW_CYCLES / f_bw)
+    return min(w, dt * (min(fit.n, validate.n) // 4))
+
+
+def used_samples(kin: Kinematics, model: NominalModel) -> np.ndarray:
+    """bool (n,): the samples the force channel judges: sliding samples with |v| above 2 % of
+    the maximum and above the model's stick speed (creep in presliding is not sliding), where the
+    friction map's own uncertainty cannot dominate the residual (:func:`map_uncertain`: a steep
+    Stribeck dip crossed within a few samples)."""
+    return kin.moving & (np.abs(kin.v) > model.v_stick()) & ~map_uncertain(kin, model)
+
+
+class _Progress:
+    """Calls progress(stage, done, total) as each of ``total`` stages starts (done: the stages
+    finished before it) and once at the end (done = total)."""
+
+    def __init__(self, fn, total: int):
+        self.fn, self.k, self.total = fn, 0, max(int(total), 1)
+
+    def __call__(self, stage: str):
+        if self.fn is None:
+            return
+        if stage == "done":
+            self.fn(stage, self.total, self.total)
+        else:
+            self.fn(stage, min(self.k, self.total), self.total)
+            self.k += 1
+
+
+def _rms(r) -> float:
+    return float(np.sqrt(np.mean(r ** 2)))
+
+
+def _members_parameters(lib, ex, cov=None) -> list:
+    """Per member of an explanation: (name, hyper, theta block, final parameters, sigma,
+    increments, the model after it); the extensions are applied in member order, each cause's
+    parameters read from the model it extends (the final values: no two members change the same
+    field)."""
+    out = []
+    cur = lib.model
+    k = 0
+    for name, j in ex.members:
+        mod = CAUSES[name]
+        v = lib.variants[name][j]
+        kk = v.Xf.shape[1]
+        th = ex.theta[k:k + kk]
+        pars = mod.parameters(th, v.hyper, cur)
+        base = mod.parameters(np.zeros(kk), v.hyper, cur)
+        inc = {key: float(pars[key] - base[key]) for key in pars if key not in v.hyper}
+        sig = {}
+        for key in pars:
+            if key in v.hyper or cov is None:
+                sig[key] = None
                 continue
-            fits = []
-            for df, dv, hyper, sf, sv in _designs(name, kf, kv, model, mf, mv):
-                A = np.column_stack([Pf, df])
-                t2, *_ = np.linalg.lstsq(A, rf0 - Sf - sf, rcond=None)
-                fits.append((float(np.sum((rf0 - Sf - sf - A @ t2) ** 2)), df, dv, hyper, t2, sf, sv))
-            if not fits:
+            grad = np.zeros(kk)
+            for i in range(kk):
+                h = 1e-6 * max(1.0, abs(th[i]))
+                tp = th.copy()
+                tp[i] += h
+                grad[i] = (mod.parameters(tp, v.hyper, cur)[key] - pars[key]) / h
+            blk = cov[k:k + kk, k:k + kk]
+            sig[key] = float(np.sqrt(max(grad @ blk @ grad, 0.0)))
+        cur = mod.extend(cur, th, v.hyper)
+        out.append((name, v.hyper, th.copy(), pars, sig, inc, cur))
+        k += kk
+    return out
+
+
+def _force_channel(lib, model, sel) -> dict:
+    """Causes, extended model, residuals and alternatives from the force channel's selection."""
+    from .force import compatible, refine
+    ex = sel["explanation"]
+    mf, mv = lib.used_f, lib.used_v
+    cov, hyper_sigma = None, {}
+    if ex.cols:
+        ex, _, cov, hyper_sigma = refine(lib, ex)
+    rows = _members_parameters(lib, ex, cov)
+    pred_v = lib.prediction(ex, "v")
+    rv_ext = np.where(mv, lib.rv - pred_v, np.nan)
+    causes = []
+    for name, hyper, th, pars, sig, inc, _ in rows:
+        sig.update(hyper_sigma.get(name, {}))
+        t = sel["tests"][name]
+        causes.append(Cause(name, t["gain"], t["t"], t["p_value"], pars, sig,
+                            dict(metric="force residual RMS [N], validation", nominal=t["rms_without"],
+                                 extended=t["rms"]), hyper, th, inc, CAUSES[name].FAMILY))
+    causes.sort(key=lambda c: -c.score)
+    ext = rows[-1][6] if rows else model
+    nominal_rms = _rms(lib.rv[mv])
+    # alternatives: (1) a cause of a selected one's family in its place; (2) a cause that explains
+    # the data alone (better BIC than the nominal model, validation gain >= 2 %) but not once the
+    # selected ones are in
+    alternatives, seen = [], {c.name for c in causes}
+    fits = sel["fits"]
+    chosen = set(ex.names)
+    for c in causes:
+        for mate in lib.variants:
+            if mate in seen or CAUSES[mate].FAMILY != c.family:
                 continue
-            # the simplest variant (first in the cause's list: e.g. the shortest cogging pitch, not
-            # a multiple of it) among those within 0.1 % of the best fit
-            ss_min = min(f[0] for f in fits)
-            ss1, df, dv, hyper, t2, sf, sv = next(f for f in fits if f[0] <= ss_min * (1 + 1e-3))
-            k = df.shape[1]
-            # effective sample size from the residual of the extended fit (the residual before it
-            # is dominated by the very effect being tested, e.g. a smooth cogging force)
-            r1 = rf0 - Sf - sf - np.column_stack([Pf, df]) @ t2
-            dof = max(_n_eff(r1) - Pf.shape[1] - k, 1.0)
-            F = ((ss0 - ss1) / k) / max(ss1 / dof, 1e-300)
-            p = float(stats.f.sf(F, k, dof))
-            rms_v = _rms(rv0 - Sv - sv - np.column_stack([Pv, dv]) @ t2)
-            gain = 1 - rms_v / _rms(rv_cur)
-            row = (name, df, dv, hyper, float(F), p, _rms(rv_cur), rms_v, gain, sf, sv)
-            why = getattr(CAUSES[name], "unphysical", lambda *a: None)(t2[Pf.shape[1]:], hyper, model)
-            if p < alpha and gain >= min_gain and why:
-                rejected.append(dict(name=name, step=len(chosen) + 1, F=float(F), p_value=p, validation_gain=gain,
-                                     reason=f"the fitted extension is not physical: {why}"))
-            elif p < alpha and gain >= min_gain:
-                if not chosen:
-                    alone[name] = (CAUSES[name].parameters(t2, hyper, model),
-                                   dict(metric="force residual RMS [N], validation, alone", nominal=_rms(rv_cur),
-                                        extended=rms_v))
-                if best is None or gain > best[8]:
-                    best = row
-            else:
-                rejected.append(dict(name=name, step=len(chosen) + 1, F=float(F), p_value=p, validation_gain=gain))
-        if best is None:
+            alt_set = tuple(sorted((chosen - {c.name}) | {mate}, key=list(lib.variants).index))
+            if not compatible(alt_set):
+                continue
+            alt = fits.get(alt_set) or lib.best_variants(alt_set)
+            if not alt.physical:
+                continue
+            row = [r for r in _members_parameters(lib, alt) if r[0] == mate][0]
+            alternatives.append(dict(name=mate, kind="same family", replaces=c.name, parameters=row[3],
+                                     bic_difference=float(alt.bic - ex.bic),
+                                     gain=dict(metric="force residual RMS [N], validation, in place of " + c.name,
+                                               nominal=nominal_rms, extended=lib.validation_rms(alt))))
+            seen.add(mate)
+    empty = fits[()]
+    for name in lib.variants:
+        if name in seen:
+            continue
+        alone = fits[(name,)]
+        if not alone.physical:
+            continue
+        rms1 = lib.validation_rms(alone)
+        if alone.bic < empty.bic and rms1 < 0.98 * nominal_rms:
+            row = _members_parameters(lib, alone)[0]
+            alternatives.append(dict(name=name, kind="alone", absorbed_by=sorted(chosen), parameters=row[3],
+                                     bic_difference=float(alone.bic - ex.bic),
+                                     gain=dict(metric="force residual RMS [N], validation, alone", nominal=nominal_rms,
+                                               extended=rms1)))
+            seen.add(name)
+    # the search's best sets: BIC on the fitting data relative to the selected explanation
+    # (negative: a set that fits the fitting data better but whose extra causes did not hold on
+    # the validation data)
+    explanations = []
+    for alt in sel["ranking"][:6]:
+        if alt.names == ex.names:
+            continue
+        explanations.append(dict(causes=list(alt.names), bic_difference=float(alt.bic - ex.bic),
+                                 validation_rms=lib.validation_rms(alt),
+                                 pruned=sorted(set(alt.names) - set(ex.names))))
+        if len(explanations) == 4:
             break
-        chosen.append(best)
-        Pf = np.column_stack([Pf, best[1]])
-        Pv = np.column_stack([Pv, best[2]])
-        Sf, Sv = Sf + best[9], Sv + best[10]
-        rejected = [r for r in rejected if r["step"] != len(chosen)]
-    # final joint fit: parameters, uncertainties, drop-one scores
-    result = []
-    rv_ext = rv0.copy()
-    if chosen:
-        th, *_ = np.linalg.lstsq(Pf, rf0 - Sf, rcond=None)
-        r = rf0 - Sf - Pf @ th
-        # residual variance inflated by n / n_eff for the correlation of smoothed residuals
-        s2 = float(r @ r) / max(r.size - Pf.shape[1], 1.0) * (r.size / max(_n_eff(r), 1.0))
-        cov = np.linalg.pinv(Pf.T @ Pf) * s2
-        rv_ext = rv0 - Sv - Pv @ th
-        full = _rms(rv_ext)
-        col = 0
-        for (name, df, dv, hyper, F, p, before, after, gain, sf, sv) in chosen:
-            k = df.shape[1]
-            sl = slice(col, col + k)
-            col += k
-            keep = np.ones(Pf.shape[1], bool)
-            keep[sl] = False
-            if keep.any():
-                t_d, *_ = np.linalg.lstsq(Pf[:, keep], rf0 - Sf + sf, rcond=None)
-                dropped = _rms(rv0 - Sv + sv - Pv[:, keep] @ t_d)
-            else:
-                dropped = _rms(rv0)
-            mod = CAUSES[name]
-            pars = mod.parameters(th[sl], hyper, model)
-            # uncertainties: propagate by finite differences through the parameter map
-            sig = {}
-            for key in pars:
-                grad = np.zeros(k)
-                for j in range(k):
-                    h = 1e-6 * max(1.0, abs(th[sl][j]))
-                    tp = th[sl].copy()
-                    tp[j] += h
-                    grad[j] = (mod.parameters(tp, hyper, model)[key] - pars[key]) / h
-                sig[key] = float(np.sqrt(max(grad @ cov[sl, sl] @ grad, 0.0)))
-            result.append(Cause(name, dropped / full - 1, F, p, pars, sig,
-                                dict(metric="force residual RMS [N], validation", nominal=before, extended=after), hyper,
-                                th[sl].copy()))
-        result.sort(key=lambda c: -c.score)
-    ext = model
-    for c in result:
-        ext = CAUSES[c.name].extend(ext, c.theta, c.hyper)
-    rf_full = np.full(kf.t.size, np.nan)
-    rf_full[mf] = rf0
-    rvn = np.full(kv.t.size, np.nan)
-    rvn[mv] = rv0
-    rve = np.full(kv.t.size, np.nan)
-    rve[mv] = rv_ext
-    picked = {c.name for c in result}
-    alternatives = [dict(name=k, parameters=v[0], gain=v[1], absorbed_by=sorted(picked))
-                    for k, v in alone.items() if k not in picked]
-    return dict(causes=result, nominal=_rms(rv0), extended=_rms(rv_ext), rejected=rejected, alternatives=alternatives,
-                model=ext, r_fit=rf_full, r_val_nom=rvn, r_val_ext=rve)
+    return dict(causes=causes, nominal=nominal_rms, extended=_rms(rv_ext[mv]), rejected=sel["rejected"],
+                alternatives=alternatives, explanations=explanations, model=ext,
+                r_fit=np.where(mf, lib.rf, np.nan), r_val_nom=np.where(mv, lib.rv, np.nan), r_val_ext=rv_ext)
 
 
 def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolution):
@@ -354,12 +430,18 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     v = mod.judge(fit, val, kf, kv, model, can_sim, resolution)
     row = dict(name=mod.NAME, step="own", statistic=v.get("statistic"), p_value=v.get("p_value"))
     if "reason" in v:
-        return None, dict(row, validation_gain=None, reason=v["reason"]), model
+        return None, dict(row, validation_gain=None, reason=v["reason"], untested=bool(v.get("untestable"))), model
     gain = 1 - v["extended"] / max(v["nominal"], 1e-300)
     if v["p_value"] >= alpha or gain < min_gain:
-        return None, dict(row, validation_gain=gain), model
+        why = []
+        if v["p_value"] >= alpha:
+            why.append(f"p = {v['p_value']:.2g} >= {alpha:g}")
+        if gain < min_gain:
+            why.append(f"validation gain {gain:.1%} < {min_gain:.0%}")
+        return None, dict(row, validation_gain=gain, reason=" and ".join(why)), model
     return (Cause(mod.NAME, v["nominal"] / max(v["extended"], 1e-300) - 1, v["statistic"], v["p_value"],
-                  v["parameters"], v["sigma"], dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"])),
+                  v["parameters"], v["sigma"], dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"]),
+                  increments=v.get("increments", {}), family=getattr(mod, "FAMILY", mod.NAME)),
             None, v["model"])
 
 
@@ -394,7 +476,8 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
         metric = "stick-segment displacement RMS [m], validation"
     gain = 1 - after / max(before, 1e-300)
     if gain < min_gain:
-        return reject(gain)
+        return reject(gain, f"validation gain {gain:.1%} < {min_gain:.0%}")
     pars = mod.parameters(theta, {}, model)
     return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, {k: None for k in pars},
-                  dict(metric=metric, nominal=before, extended=after), {}, np.asarray(theta)), None, ext)
+                  dict(metric=metric, nominal=before, extended=after), {}, np.asarray(theta),
+                  family=getattr(mod, "FAMILY", mod.NAME)), None, ext)

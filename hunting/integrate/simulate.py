@@ -12,6 +12,11 @@ from . import _kernel as K
 from ._tableau import METHODS
 
 
+#: the largest |x_i| a run starts from: cubes of the state stay finite in double precision
+#: (x**3 overflows beyond 5.6e102); no physical state in any unit comes near it
+MAX_STATE = 1e100
+
+
 def _grow(a: np.ndarray, rows: int) -> np.ndarray:
     new = np.empty((rows,) + a.shape[1:], dtype=a.dtype)
     new[: a.shape[0]] = a
@@ -156,6 +161,9 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
 
     m0 = _mode(mode0, "mode0")
     sm = _mode(stop_mode, "stop_mode")
+    bad_start = _start_problem(system, t0, x0, m0, p)
+    if bad_start is not None:
+        return _ended_at_start(system, t0, x0, bad_start, key, throw)
     if t_eval is not None:
         te = np.ascontiguousarray(t_eval, dtype=np.float64).reshape(-1)
         if te.size == 0 or np.any(np.diff(te) < 0) or te[0] < t0 or te[-1] > t1 or not np.all(np.isfinite(te)):
@@ -208,6 +216,10 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
         if not fixed:
             h0 = float(finfo[K.F_H])
     status, message = make_status(int(info[K.I_STATUS]), float(finfo[K.F_T]))
+    if status == Status.NON_FINITE and system.explain is not None:
+        detail = system.explain(int(info[K.I_MODE]), float(finfo[K.F_T]), x_final, p)
+        if detail:
+            message = f"{message}; {detail}"
     if status == Status.INVALID_MODE:
         raise SystemDefinitionError(f"{system.name}: mode function or transition returned mode "
                                     f"{int(info[K.I_MODE])}, not one of 0..{system.n_modes - 1}")
@@ -229,6 +241,72 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     traj = Trajectory(t_out, x_out, m_out, events, status, message, system.state_names,
                       tuple(m.name for m in system.modes), stats)
     if throw and not status.ok:
+        raise ConvergenceError(f"{system.name}: {message}", traj)
+    return traj
+
+
+def _start_problem(system: PiecewiseSystem, t0: float, x0: np.ndarray, m0: int, p: np.ndarray):
+    """(status, mode, message) when a run cannot start: a state beyond :data:`MAX_STATE`
+    (OUT_OF_BOUNDS), or a vector field or guard that is not finite at the initial state
+    (NON_FINITE, naming the model's expression when the system can: ``system.explain``);
+    None when it can. Checked before integrating, so the cause is named instead of a step size
+    that collapses at t0."""
+    big = np.flatnonzero(np.abs(x0) > MAX_STATE)
+    mode = m0 if m0 >= 0 else int(system.mode_of(t0, x0, p))
+    if big.size:
+        i = int(big[0])
+        return (Status.OUT_OF_BOUNDS, mode,
+                f"at t = {t0:.12g}: the initial state {system.state_names[i]} = {x0[i]:.4g} is beyond {MAX_STATE:g}, "
+                "the largest magnitude a run starts from (powers of the state overflow double precision): "
+                "give an initial state of physical size")
+    if not 0 <= mode < system.n_modes:
+        return None                     # the kernel reports INVALID_MODE
+    f = np.empty(system.n_states)
+    g = np.empty(system.n_guards)
+    with np.errstate(all="ignore"):
+        system.vector_field(mode, t0, x0, p, f)
+        system.guards(mode, t0, x0, p, g)
+    if np.all(np.isfinite(f)) and np.all(np.isfinite(g)):
+        return None
+    detail = system.explain(mode, t0, x0, p) if system.explain is not None else None
+    if detail is None:
+        parts = [f"d{n}/dt = {v}" for n, v in zip(system.state_names, f) if not np.isfinite(v)]
+        parts += [f"guard '{n}' = {v}" for n, v in zip(system.guard_names or ("guard",), g) if not np.isfinite(v)]
+        zeros = _zero_parameters_to_blame(system, mode, t0, x0, p)
+        detail = ", ".join(parts) + (f" (finite with {', '.join(z + ' != 0' for z in zeros)})" if zeros else "")
+    return (Status.NON_FINITE, mode,
+            f"at t = {t0:.12g}: the vector field is not finite at the initial state (mode {system.modes[mode].name}): "
+            f"{detail}; change the parameter values or the initial state")
+
+
+def _zero_parameters_to_blame(system: PiecewiseSystem, mode: int, t0: float, x0: np.ndarray, p: np.ndarray) -> list:
+    """The named parameters that are 0 and whose change to 1 alone makes the vector field and
+    guards finite at the initial state (a division by a zero mass, say)."""
+    out = []
+    f = np.empty(system.n_states)
+    g = np.empty(system.n_guards)
+    for j, name in enumerate(system.param_names):
+        if p[j] != 0:
+            continue
+        q = p.copy()
+        q[j] = 1.0
+        with np.errstate(all="ignore"):
+            system.vector_field(mode, t0, x0, q, f)
+            system.guards(mode, t0, x0, q, g)
+        if np.all(np.isfinite(f)) and np.all(np.isfinite(g)):
+            out.append(name)
+    return out
+
+
+def _ended_at_start(system, t0, x0, problem, method, throw) -> Trajectory:
+    """The trajectory of a run that cannot start: the initial point and the reason."""
+    status, mode, message = problem
+    none = np.empty(0)
+    events = EventLog(none, np.empty((0, x0.size)), np.empty((0, x0.size)), *(np.empty(0, dtype=np.int64),) * 3)
+    stats = dict(n_steps=0, n_rejected=0, n_fev=1, n_jac=0, method=method)
+    traj = Trajectory(np.array([t0]), x0[None, :].copy(), np.array([max(mode, 0)], dtype=np.int64), events, status,
+                      message, system.state_names, tuple(m.name for m in system.modes), stats)
+    if throw:
         raise ConvergenceError(f"{system.name}: {message}", traj)
     return traj
 

@@ -7,8 +7,13 @@ into named physical parameters, and ``extend(model, theta, hyper)`` returning th
 NominalModel (what the behaviour view re-simulates); optionally ``unphysical(theta, hyper, model)``
 returning why a fitted theta is not the physical effect (the cause is then rejected), else None;
 optionally ``shift(kin, model, hyper)``: the known, unfitted part (n,) [N] of the extension's
-force change (e.g. the nominal Stribeck dip moved to a new vs). Adding a cause is adding a module
-and listing it here."""
+force change (e.g. the nominal Stribeck dip moved to a new vs). Also: ``FAMILY`` (causes that share
+a signature share it), ``HYPERS`` (continuous hyper-parameters searched, counted in BIC),
+``HYPER_KEYS`` (those refined by Gauss-Newton), ``UNITS`` (of the parameters), ``sentence(p,
+increments, model)`` (the finding in words), ``untestable(kin, model)`` (why a record cannot test
+it), ``EXCLUDES`` (causes it cannot be combined with), ``NOISE_FED`` (its regressor is made of
+measured derivatives: judged also along a noise-free instrument trajectory). Adding a cause is
+adding a module and listing it here."""
 from ..model import NominalModel
 from ...models.friction import DirectionalCurve
 

@@ -1,28 +1,57 @@
-"""Direction-dependent friction: different viscous coefficients for positive and negative
-velocity (a Coulomb-level difference is a constant force while moving: the ``offset`` cause)."""
+"""Direction-dependent viscous friction: b+ for positive and b- for negative velocity, each free
+(a Coulomb-level difference is a constant force while moving: the ``offset`` cause; equal changes
+are the ``viscous`` cause, the special case b+ - b- unchanged)."""
 from dataclasses import replace
 
 import numpy as np
 
 from . import with_curves
+from ._words import _pct, _q
 
 NAME = "asymmetry"
 DESCRIPTION = "direction-dependent viscous friction (b+ != b-)"
+FAMILY = "velocity"
+HYPERS = 0
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+EXCLUDES = ("viscous",)      # v = max(v, 0) + min(v, 0): viscous is the special case b+ = b-
+UNITS = {"b_pos": "N s/m", "b_neg": "N s/m"}
 
 
 def hypers(kin, model) -> list:
     return [{}]
 
 
+def untestable(kin, model) -> str | None:
+    """Both directions must be driven: at least 10 % of the sliding samples each way."""
+    v = kin.v[kin.moving]
+    share = min(np.mean(v > 0), np.mean(v < 0)) if v.size else 0.0
+    return None if share >= 0.1 else f"the record moves one way only ({share:.0%} of the sliding samples the other way)"
+
+
 def design(kin, model, hyper):
-    return kin.filtered(np.abs(kin.v))[:, None]
+    return kin.sliding(np.column_stack([np.maximum(kin.vf, 0.0), np.minimum(kin.vf, 0.0)]))
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    bp, bn = model.curve.positive.b + float(theta[0]), model.curve.negative.b + float(theta[1])
+    return f"b+ = {bp:.3g}, b- = {bn:.3g} N s/m: a negative viscous coefficient" if min(bp, bn) < 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:
-    bp, bn = model.curve.positive.b, model.curve.negative.b
-    return {"b_pos": float(bp + theta[0]), "b_neg": float(bn - theta[0]), "delta_b": float(theta[0])}
+    return {"b_pos": float(model.curve.positive.b + theta[0]), "b_neg": float(model.curve.negative.b + theta[1])}
 
 
 def extend(model, theta, hyper):
-    d = float(theta[0])
-    return with_curves(model, lambda c: replace(c, b=c.b + d), lambda c: replace(c, b=c.b - d))
+    return with_curves(model, lambda c: replace(c, b=c.b + float(theta[0])),
+                       lambda c: replace(c, b=c.b + float(theta[1])))
+
+
+def sentence(p, inc, model) -> str:
+    parts = []
+    for key, side, c in (("b_pos", "positive", model.curve.positive), ("b_neg", "negative", model.curve.negative)):
+        rel = p[key] / c.b - 1 if c.b else float("inf")
+        if abs(rel) >= 0.005:
+            word = "underestimates" if rel > 0 else "overestimates"
+            parts.append(f"{word} viscous friction for {side} velocities by {_pct(abs(rel))} "
+                         f"({key} = {_q(p[key], None, 'N s/m')} instead of {_q(c.b, None, 'N s/m')})")
+    return "the model " + (" and ".join(parts) if parts else "has the viscous friction of both directions nearly right")

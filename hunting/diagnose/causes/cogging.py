@@ -3,16 +3,21 @@ spatial period found from the residual's Lomb-Scargle spectrum against position.
 import numpy as np
 
 from ...models.plant import Cogging
+from ._words import _q
 
 NAME = "cogging"
 DESCRIPTION = "force periodic in position (cogging)"
+FAMILY = "position"
+HYPERS = 1
+HYPER_KEYS = ("pitch",)
+UNITS = {"pitch": "m", "amplitude_1": "N", "amplitude_2": "N", "amplitude_3": "N"}
 HARMONICS = 3
 
 
 def hypers(kin, model) -> list:
     """Pitch candidates: the three strongest peaks of the Lomb-Scargle spectrum of the nominal
-    force residual (averaged in position bins) against position (wavelengths from 20 samples' travel at the typical speed to
-    a quarter of the stroke), each refined on a +-3 % grid of 0.2 % steps."""
+    force residual (averaged in position bins) against position (wavelengths from 20 samples'
+    travel at the typical speed to a quarter of the stroke), each refined on a +-3 % grid."""
     from scipy.signal import lombscargle
     from ..kinematics import residual
     moving = kin.moving
@@ -28,7 +33,7 @@ def hypers(kin, model) -> list:
     # the spectrum of the residual averaged in position bins of a tenth of the shortest
     # wavelength: what is periodic in q survives the averaging, the cost falls from the samples
     # (tens of thousands, visited again and again) to the bins
-    width = lo / 10
+    width = max(lo / 10, stroke / 2000)                     # at most ~2000 bins
     idx = np.floor((q - q.min()) / width).astype(np.int64)
     counts = np.bincount(idx)
     full = counts > 0
@@ -37,18 +42,38 @@ def hypers(kin, model) -> list:
     power = lombscargle(qb, rb - rb.mean(), 2 * np.pi * k)
     peaks = [i for i in range(1, k.size - 1) if power[i] >= power[i - 1] and power[i] >= power[i + 1]]
     peaks = sorted(peaks, key=lambda i: -power[i])[:3]
+    # each peak refined on a +-3 % grid of 0.2 % steps by least squares of the harmonics on the
+    # binned residual (the simplest variant, first in the grid, among those within 0.1 % of the
+    # best: e.g. not a multiple of the pitch)
     out = []
     for i in peaks:
-        out += [{"pitch": float(f / k[i])} for f in np.linspace(0.97, 1.03, 31)]
-    return out
+        fits = []
+        for f in np.linspace(0.97, 1.03, 31):
+            pitch = float(f / k[i])
+            A = _harmonics(qb, pitch)
+            th, *_ = np.linalg.lstsq(A, rb - rb.mean(), rcond=None)
+            fits.append((float(np.sum((rb - rb.mean() - A @ th) ** 2)), pitch))
+        best = min(s for s, _ in fits)
+        out.append({"pitch": next(p for s, p in fits if s <= best * (1 + 1e-3))})
+    return sorted(out, key=lambda h: h["pitch"])
+
+
+def _harmonics(q, pitch):
+    cols = []
+    for k in range(1, HARMONICS + 1):
+        w = 2 * np.pi * k / pitch
+        cols += [np.cos(w * q), np.sin(w * q)]
+    return np.column_stack(cols)
+
+
+def untestable(kin, model) -> str | None:
+    if kin.moving.sum() < 50:
+        return "fewer than 50 sliding samples"
+    return None
 
 
 def design(kin, model, hyper):
-    cols = []
-    for k in range(1, HARMONICS + 1):
-        w = 2 * np.pi * k / hyper["pitch"]
-        cols += [np.cos(w * kin.q), np.sin(w * kin.q)]
-    return kin.filtered(np.column_stack(cols))
+    return kin.sliding(_harmonics(kin.q, hyper["pitch"]))
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -61,3 +86,8 @@ def parameters(theta, hyper, model) -> dict:
 def extend(model, theta, hyper):
     comp = Cogging.harmonic(hyper["pitch"], cos=list(theta[0::2]), sin=list(theta[1::2]))
     return model.replace(cogging=model.cogging + (comp,))
+
+
+def sentence(p, inc, model) -> str:
+    return (f"a force periodic in position that the model lacks: pitch {_q(p['pitch'], None, 'm')}, "
+            f"first harmonic {_q(p['amplitude_1'], None, 'N')}")

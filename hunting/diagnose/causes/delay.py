@@ -1,20 +1,52 @@
-"""Actuation delay tau: the plant receives cm u(t - tau) ~ cm u(t) - tau cm u'(t), so the
-residual gains tau cm u'(t) (first order in tau, valid while tau << the signal's time scales)."""
+"""Actuation delay tau: the plant receives cm u(t - tau) instead of cm u(t), so the residual gains
+cm u(t) - cm u(t - tau). The regressor at a trial delay tau is that difference divided by tau
+(the drive force's rate for small tau, linear interpolation between samples): its coefficient is
+tau itself when the trial is right, and the Gauss-Newton refinement of tau (``HYPER_KEYS``)
+makes the two agree for delays of many samples, where the first-order term tau cm u' is not
+enough."""
+import numpy as np
+
+from ._words import _q
+
 NAME = "delay"
 DESCRIPTION = "actuation or measurement delay"
+FAMILY = "velocity"
+HYPERS = 0
+HYPER_KEYS = ("tau",)
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+UNITS = {"delay": "s"}
 
 
 def hypers(kin, model) -> list:
-    return [{}]
+    return [{"tau": kin.dt}]
+
+
+def hyper_bounds(kin, model) -> dict:
+    return {"tau": (0.25 * kin.dt, 0.25 * kin.window + 20 * kin.dt)}
 
 
 def design(kin, model, hyper):
-    return (kin.cm * kin.du)[:, None]
+    # on top of the model's own delay (the residual's drive is already delayed by it)
+    tau, d0 = hyper["tau"], model.delay
+    now = np.interp(kin.t - d0, kin.t, kin.drive) if d0 > 0 else kin.drive
+    late = np.interp(kin.t - d0 - tau, kin.t, kin.drive)
+    return kin.sliding((now - late) / tau)[:, None]
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    d = model.delay + float(theta[0])
+    return f"delay = {d:.3g} s < 0 (the plant would act before the command)" if d < 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:
-    return {"delay": float(theta[0])}
+    return {"delay": float(model.delay + theta[0])}
 
 
 def extend(model, theta, hyper):
     return model.replace(delay=max(model.delay + float(theta[0]), 0.0))
+
+
+def sentence(p, inc, model) -> str:
+    d = inc.get("delay", p["delay"])
+    return (f"the drive force acts {_q(abs(d), None, 's')} {'later' if d >= 0 else 'earlier'} than the model assumes "
+            f"(delay {_q(p['delay'], None, 's')})")

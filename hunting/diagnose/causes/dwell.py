@@ -6,22 +6,27 @@ Rests are read from the measured positions (runs within two encoder counts for a
 :func:`hunting.diagnose.behaviour.stick_phases`) that end in motion before the record does; the
 record's first rest is skipped (how long the contact rested before it is unknown). At rest a = 0,
 so the force friction carries at the end of a rest is F = cm u + f_ext - offset - F_cog(q)
-(u aligned for the zero-order hold, averaged over the 10 ms before the position is two counts
-from its rest value: the break-away lies in that span); its excess over the model's break-away force in
+(u aligned for the zero-order hold; a straight line through the 10 ms before the position is two
+counts from its rest value, at its end: the break-away lies in that span, and the force ramps
+into it); its excess over the model's break-away force in
 the direction of the motion that follows is e_k. The extension fits
 
     e_k = level + gain (1 - exp(-t_k / time))     (t_k the rest's duration)
 
-(level and gain linear, time on a logarithmic grid over the measured rests). Evidence: the F test
-of the time-dependent term against a constant level alone (a wrong Fs is a constant, not dwell),
-with 2 numerator degrees of freedom (gain and time). Gain: the RMS of e on the validation data's
-rests, nominal (the model's break-away force) against extended."""
+(level and gain linear, time on a logarithmic grid over the measured rests). Evidence, out of
+sample like the force channel's: on the validation data's rests, the growth predicted by the fit
+against a constant level (a wrong Fs is a constant, not dwell) must explain the measured excess,
+one-sided t test over independent rests. Gain: the RMS of e on the validation data's rests,
+nominal (the model's break-away force) against extended."""
 import numpy as np
 from scipy import stats
+from ._words import _q
 
 NAME = "dwell"
 DESCRIPTION = "break-away force growing with the time at rest"
 CHANNEL = "own"
+FAMILY = "break-away"
+UNITS = {"level": "N", "gain": "N", "time": "s"}
 MIN_RESTS = 6
 
 
@@ -30,6 +35,8 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
     at its last sample, and the direction of the motion that follows (+1 / -1)."""
     from ..behaviour import stick_phases
     dt = meas.dt
+    # a count, or the sensor's noise band where that is wider (noise would fake moves and rests)
+    resolution = max(resolution, 1e-15) + 4.0 * model.sensor_noise
     phases = stick_phases(meas.q, dt, resolution)
     u_at = np.concatenate([[meas.u[0]], 0.5 * (meas.u[1:] + meas.u[:-1])])
     F = model.cm * u_at + meas.force_ext() - model.offset - model.cogging_force(meas.q)
@@ -46,10 +53,17 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
             continue
         m = a + int(moved[0])         # the first sample two counts away: motion has begun
         tr.append((m - a) * dt)
-        # a digital loop's u is noisy (the velocity estimate of a quantized position); the
-        # break-away lies within the ~10 ms before the motion shows: average over that span
-        Fb.append(float(np.mean(F[m - span:m])))
-        sd.append(np.sign(meas.q[m] - q_rest))
+        # a digital loop's u is noisy (the velocity estimate of a quantized position) and ramps
+        # up to the break-away (an integral action at a rate set by the error at rest: faster for
+        # shorter rests, so a mean would fake a dwell effect); the break-away lies within the
+        # ~10 ms before the motion shows: a straight line through that span, at its end
+        k = np.arange(span, dtype=float)
+        slope, icpt = np.polyfit(k, F[m - span:m], 1)
+        Fb.append(float(icpt + slope * (span - 1)))
+        # the motion follows the force that broke the contact away (the position's first step
+        # decides only when that force is small)
+        Fs = min(model.curve.positive.Fs, model.curve.negative.Fs)
+        sd.append(np.sign(Fb[-1]) if abs(Fb[-1]) > 0.5 * Fs else np.sign(meas.q[m] - q_rest))
     return np.array(tr), np.array(Fb), np.array(sd)
 
 
@@ -84,25 +98,37 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     from ..model import Dwell
     t, F, s = rests(fit, model, resolution)
     if t.size < MIN_RESTS:
-        return dict(reason=f"{t.size} rests ending in motion in the fitting data (need {MIN_RESTS})")
+        return dict(reason=f"{t.size} rests ending in motion in the fitting data (need {MIN_RESTS})", untestable=True)
     if np.ptp(t) < 0.5 * np.mean(t):
-        return dict(reason=f"the rests all last about {np.mean(t):.3g} s: a dwell effect cannot be told from Fs")
+        return dict(reason=f"the rests all last about {np.mean(t):.3g} s: a dwell effect cannot be told from Fs", untestable=True)
     e = excess(model, t, F, s)
     (ss, th, tau), ss0 = _fit(t, e)
     dof = t.size - 4
     if dof < 1:
-        return dict(reason="too few rests for the F test")
-    Fstat = ((ss0 - ss) / 2) / max(ss / dof, 1e-300)
-    p = float(stats.f.sf(Fstat, 2, dof))
-    out = dict(statistic=float(Fstat), p_value=p)
+        return dict(reason="too few rests to fit the growth", untestable=True)
     if th[1] <= 0:
-        return dict(out, reason=f"the break-away force falls with the rest (gain {th[1]:.3g} N): not a dwell effect")
+        return dict(statistic=None, p_value=None,
+                    reason=f"the break-away force falls with the rest (gain {th[1]:.3g} N): not a dwell effect")
     tv, Fv, sv = rests(validate, model, resolution)
     if tv.size < 3:
-        return dict(out, reason=f"{tv.size} rests ending in motion in the validation data (need 3)")
+        return dict(reason=f"{tv.size} rests ending in motion in the validation data (need 3)", untestable=True)
+    # out of sample: does the growth fitted on the fitting rests explain the validation rests'
+    # break-away excess beyond a constant level (a wrong Fs)? One-sided t test of gamma in
+    # e_v - level0 = gamma (prediction - level0) + eps over independent rests
+    ev = excess(model, tv, Fv, sv)
+    level0 = float(np.mean(e))
+    yhat = _design(tv, tau) @ th - level0
+    e0 = ev - level0
+    syy = float(yhat @ yhat)
+    if not syy > 0 or tv.size < 3:
+        return dict(reason="the validation rests do not vary the predicted growth", untestable=True)
+    gamma = float(yhat @ e0) / syy
+    s2 = float(np.sum((e0 - gamma * yhat) ** 2)) / (tv.size - 1)
+    tstat = gamma / np.sqrt(max(s2, 1e-300) / syy)
+    out = dict(statistic=float(tstat), p_value=float(stats.t.sf(tstat, tv.size - 1)))
     base = model.dwell or Dwell(0.0, 0.0, tau)
     ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau))
-    ev0, ev1 = excess(model, tv, Fv, sv), excess(ext, tv, Fv, sv)
+    ev0, ev1 = ev, excess(ext, tv, Fv, sv)
     A = _design(t, tau)
     cov = np.linalg.pinv(A.T @ A) * ss / dof
     # the time's standard uncertainty from the curvature of the residual sum of squares in tau
@@ -115,3 +141,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
                 sigma={"level": float(np.sqrt(cov[0, 0])), "gain": float(np.sqrt(cov[1, 1])), "time": sig_tau},
                 metric="break-away force RMS error [N], validation rests",
                 nominal=float(np.sqrt(np.mean(ev0 ** 2))), extended=float(np.sqrt(np.mean(ev1 ** 2))), model=ext)
+
+
+def sentence(p, inc, model) -> str:
+    return (f"the break-away force grows with the time at rest by up to {_q(p['gain'], None, 'N')} "
+            f"(time constant {_q(p['time'], None, 's')}), which the model's constant static level lacks")

@@ -5,64 +5,112 @@ hyper-parameter grid scans around the peaks of the residual's spectrum."""
 import numpy as np
 
 from ..model import Flexibility, highpass_response
+from ._words import _q
 
 NAME = "flexibility"
 DESCRIPTION = "an unmodelled resonance (load on a spring behind the measured side)"
+FAMILY = "inertia"
+HYPERS = 2
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+HYPER_KEYS = ("frequency", "damping")
+UNITS = {"load_mass": "kg", "frequency": "Hz", "damping": "", "stiffness": "N/m"}
 DAMPING = (0.02, 0.05, 0.1, 0.2, 0.4)
 DAMPING_MAX = (0.002, 1.0)            # the damping ratios the refinement may reach
+NOISE_MARGIN = 100.0                  # the acceleration power above the encoder noise's, in the band
 
 
 def hypers(kin, model) -> list:
     """(frequency, damping) candidates: for each of the two strongest peaks of the nominal
-    residual's spectrum (Welch) between 2 Hz and a tenth of the sampling rate, the best of a
-    +-20 % frequency grid times the damping ratios in DAMPING, refined by least squares in
-    (log frequency, log damping) with the load mass eliminated (variable projection)."""
+    residual's spectrum (Welch) in the band where a resonance can be seen (:func:`band`), the
+    best of a +-20 % frequency grid times the damping ratios in DAMPING, refined by least squares
+    in (log frequency, log damping) with the load mass eliminated (variable projection) on the
+    moving samples, with the regressor -H(s) a (the sliding mask applied after the filter)."""
     from scipy.optimize import minimize
     from scipy.signal import find_peaks, welch
     from ..kinematics import residual
-    dt = float(kin.t[1] - kin.t[0])
+    dt = kin.dt
     r = residual(kin, model)
     m = kin.moving & np.isfinite(r)
-    if m.sum() < 512:
-        return []
+    lo, hi = band(kin)
     f, P = welch(np.where(m, r - r[m].mean(), 0.0), fs=1.0 / dt, nperseg=min(4096, r.size // 4))
-    band = (f >= 2.0) & (f <= 0.1 / dt)
-    if band.sum() < 5:
+    inside = (f >= lo) & (f <= hi)
+    if inside.sum() < 5:
         return []
-    fb, Pb = f[band], P[band]
+    fb, Pb = f[inside], P[inside]
     idx, _ = find_peaks(Pb)
     idx = sorted(idx, key=lambda i: -Pb[i])[:2]
+    # every third of a filter window among the moving samples: the regressor is smooth at that scale
+    m = np.flatnonzero(m)[::max(1, int(round(kin.window / dt)) // 3)]
+    rm, am = r[m], kin.a
 
     def fit(z):
-        x = design(kin, model, {"frequency": float(np.exp(z[0])), "damping": float(np.exp(z[1]))})[m, 0]
-        th = float(x @ r[m]) / max(float(x @ x), 1e-300)
-        e = r[m] - th * x
+        x = -highpass_response(am, dt, float(np.exp(z[0])), float(np.exp(z[1])))[m]
+        th = float(x @ rm) / max(float(x @ x), 1e-300)
+        e = rm - th * x
         return float(e @ e), th
 
     def ss(z):
         # a resonance is lightly damped (zeta <= 1), inside the band, with a positive load mass
-        if not (np.log(DAMPING_MAX[0]) <= z[1] <= np.log(DAMPING_MAX[1]) and np.log(2.0) <= z[0] <= np.log(0.1 / dt)):
+        if not (np.log(DAMPING_MAX[0]) <= z[1] <= np.log(DAMPING_MAX[1]) and np.log(lo) <= z[0] <= np.log(hi)):
             return np.inf
         val, th = fit(z)
         return val if th > 0 else np.inf
     out = []
     for i in idx:
-        grid = [(np.log(fb[i] * s), np.log(zeta)) for s in np.linspace(0.8, 1.2, 11) for zeta in DAMPING]
+        grid = [(np.log(fb[i] * s), np.log(zeta)) for s in np.linspace(0.8, 1.2, 9) for zeta in DAMPING]
         z0 = min(grid, key=ss)
         if not np.isfinite(ss(z0)):
             continue                                  # no positive load mass fits near this peak
         # outside the admissible set: a finite penalty (inf - inf would be NaN in the simplex test)
         cap = 1e6 * ss(z0)
         res = minimize(lambda z: min(ss(z), cap), z0, method="Nelder-Mead",
-                       options=dict(xatol=1e-4, fatol=1e-10, maxiter=200))
+                       options=dict(xatol=1e-3, fatol=1e-9, maxiter=80))
         z = res.x if res.fun <= ss(z0) else z0
-        out.append({"frequency": float(np.exp(z[0])), "damping": float(np.exp(z[1]))})
+        f0, zeta = float(np.exp(z[0])), float(np.exp(z[1]))
+        # a fit that runs to the edge of the admissible set has found no resonance there
+        if zeta > 0.95 * DAMPING_MAX[1] or zeta < 1.05 * DAMPING_MAX[0] or f0 < 1.02 * lo or f0 > 0.98 * hi:
+            continue
+        out.append({"frequency": f0, "damping": zeta})
     return out
 
 
+def band(kin) -> tuple[float, float]:
+    """(lowest, highest) resonance frequency [Hz] this record can show: from 2 Hz to a tenth of
+    the sampling rate, and no higher than where the measured acceleration's spectrum falls below
+    NOISE_MARGIN times the part the position sensor's noise puts there (above it the acceleration, and
+    every regressor made of it, is the encoder's noise, and a "resonance" fits that noise in the
+    force residual and the validation data alike)."""
+    from scipy.signal import welch
+    from ..kinematics import acceleration_noise_psd
+    dt = kin.dt
+    hi = 0.1 / dt
+    if kin.resolution > 0 or kin.noise > 0:
+        m = kin.moving
+        f, P = welch(np.where(m, kin.a - kin.a[m].mean(), 0.0), fs=1.0 / dt, nperseg=min(4096, kin.a.size // 4))
+        P = P * kin.a.size / max(m.sum(), 1)       # the PSD of the moving samples alone
+        ok = (f >= 2.0) & (P > NOISE_MARGIN * acceleration_noise_psd(kin, f))
+        above = f[(f >= 2.0) & ~ok]
+        hi = min(hi, float(above[0]) if above.size else hi)
+    return 2.0, hi
+
+
+def hyper_bounds(kin, model) -> dict:
+    """The refinement's range: the band a resonance can be seen in, damping ratios DAMPING_MAX."""
+    return {"frequency": band(kin), "damping": DAMPING_MAX}
+
+
+def untestable(kin, model) -> str | None:
+    if (kin.moving & np.isfinite(kin.a)).sum() < 512:
+        return "fewer than 512 sliding samples"
+    lo, hi = band(kin)
+    if hi < 2 * lo:
+        return (f"above {hi:.3g} Hz the measured acceleration is the position sensor's noise: no band to see a "
+                "resonance in")
+    return None
+
+
 def design(kin, model, hyper):
-    dt = float(kin.t[1] - kin.t[0])
-    return -highpass_response(kin.a, dt, hyper["frequency"], hyper["damping"])[:, None]
+    return -kin.sliding(highpass_response(kin.a_inst, kin.dt, hyper["frequency"], hyper["damping"]))[:, None]
 
 
 def unphysical(theta, hyper, model) -> str | None:
@@ -79,3 +127,8 @@ def parameters(theta, hyper, model) -> dict:
 def extend(model, theta, hyper):
     # the force residual carries the load; the re-simulation engine models the rigid body only
     return model.replace(flexibility=Flexibility(max(float(theta[0]), 0.0), hyper["frequency"], hyper["damping"]))
+
+
+def sentence(p, inc, model) -> str:
+    return (f"a resonance the rigid model lacks: {_q(p['load_mass'], None, 'kg')} of the load on a spring of "
+            f"{_q(p['stiffness'], None, 'N/m')} ({_q(p['frequency'], None, 'Hz')}, damping ratio {p['damping']:.2g})")

@@ -1,8 +1,12 @@
 """A constant force (gravity on an incline, a cable, an electrical offset in the amplifier)."""
 import numpy as np
+from ._words import _q
 
 NAME = "offset"
 DESCRIPTION = "constant force on the load"
+FAMILY = "level"
+HYPERS = 0
+UNITS = {"offset": "N"}
 
 
 def hypers(kin, model) -> list:
@@ -10,7 +14,7 @@ def hypers(kin, model) -> list:
 
 
 def design(kin, model, hyper):
-    return np.ones((kin.t.size, 1))
+    return kin.sliding(np.ones(kin.t.size))[:, None]
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -19,3 +23,10 @@ def parameters(theta, hyper, model) -> dict:
 
 def extend(model, theta, hyper):
     return model.replace(offset=model.offset + float(theta[0]))
+
+
+def sentence(p, inc, model) -> str:
+    side = "negative" if p["offset"] > 0 else "positive"
+    return (f"a constant force of {_q(abs(p['offset']), None, 'N')} pushes the load towards {side} positions "
+            f"(the model has {_q(model.offset, None, 'N')}; a Coulomb level differing by twice that between the "
+            "directions looks the same while the load moves)")

@@ -25,17 +25,19 @@ The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 = 
 (damping ratio 0.5 of the presliding resonance) because creeping data cannot determine it."""
 import numpy as np
 from scipy.signal import savgol_filter
+from ._words import _q
 
 NAME = "presliding"
 DESCRIPTION = "finite stick stiffness: motion while |F| < Fs (LuGre sigma0)"
 CHANNEL = "stick"
+FAMILY = "bristles"
+UNITS = {"sigma0": "N/m", "sigma1": "N s/m"}
 ZETA = 0.5
 
 
 def friction_force(kin, model) -> np.ndarray:
     """The force friction must carry [N] (n,), from the measured drive and motion."""
-    from ..kinematics import residual
-    return residual(kin, model) + kin.filtered(model.friction(kin.v))
+    return kin.filtered(kin.drive - model.offset - model.cogging_force(kin.q)) - model.mass * kin.a
 
 
 def v_stick(kin, model) -> float:
@@ -163,3 +165,8 @@ def parameters(theta, hyper, model) -> dict:
 def extend(model, theta, hyper):
     p = parameters(theta, hyper, model)
     return model.replace(law="lugre", sigma0=p["sigma0"], sigma1=p["sigma1"])
+
+
+def sentence(p, inc, model) -> str:
+    return (f"the mass creeps where the model holds it still: the contact is a spring of "
+            f"{_q(p['sigma0'], None, 'N/m')} below the break-away force (LuGre bristles)")

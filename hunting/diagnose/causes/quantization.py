@@ -10,10 +10,13 @@ extension sets the controller's ``output_resolution`` and the sensor resolution 
 gain is the fall of the re-simulated position RMS error on the validation data (needs the
 controller and the reference)."""
 from scipy import stats
+from ._words import _q
 
 NAME = "quantization"
 DESCRIPTION = "controller output (DAC) or sensor quantization different from the model's"
 CHANNEL = "own"
+FAMILY = "actuator"
+UNITS = {"output_resolution": "", "sensor_resolution": "m"}
 
 
 def judge(fit, validate, kf, kv, model, can_sim, resolution):
@@ -35,7 +38,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     if not changes:
         return dict(out, reason="the data's quantization (of u and q) is the model's")
     if not can_sim:
-        return dict(out, reason="the gain needs re-simulation: the model's controller and the reference q_ref")
+        return dict(out, reason="the gain needs re-simulation: the model's controller and the reference q_ref", untestable=True)
     ext = model
     if "output_resolution" in changes:
         ext = ext.replace(controller=dict(ctrl, output_resolution=du))
@@ -45,3 +48,12 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
                 metric="re-simulated position RMS error [m], validation", nominal=position_rms_error(validate, model),
                 extended=position_rms_error(validate, ext),
                 model=ext)
+
+
+def sentence(p, inc, model) -> str:
+    out = []
+    if "output_resolution" in p:
+        out.append(f"the controller output moves in steps of {p['output_resolution']:.4g} (in u's unit: a DAC)")
+    if "sensor_resolution" in p:
+        out.append(f"the position sensor's resolution is {_q(p['sensor_resolution'], None, 'm')}")
+    return " and ".join(out) + ", unlike the model's"

@@ -11,7 +11,7 @@ Stribeck level of that direction), and the regressor is the change of the fricti
 sigma0 z + sigma1 z' - sign(v) g(|v|) (sigma1 as in the extension: right after a reversal
 z' = 2 v, and the bristle damping dominates the transient). Its
 coefficient ``scale`` is 1 for LuGre: the whole level builds up after a reversal. A fit far from
-1 (outside [0.5, 2]) is a friction deficit near reversals of another kind, and the cause is
+1 (outside [0.3, 3]) is a friction deficit near reversals of another kind, and the cause is
 rejected as not physical.
 
 The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 as in
@@ -20,10 +20,15 @@ import numba
 import numpy as np
 
 from . import presliding
+from ._words import _q
 
 NAME = "reversal"
 DESCRIPTION = "presliding after velocity reversals: friction builds up over a slip Fc/sigma0 (LuGre)"
-SCALE_RANGE = (0.5, 2.0)
+FAMILY = "inertia"
+HYPERS = 1
+HYPER_KEYS = ("sigma0",)
+UNITS = {"sigma0": "N/m", "scale": ""}
+SCALE_RANGE = (0.3, 3.0)
 
 
 @numba.njit(cache=True)
@@ -51,8 +56,18 @@ def hypers(kin, model) -> list:
     return [{"sigma0": float(Fc / x)} for x in np.geomspace(5e-3, min(shortest, 5e-4), 25)]
 
 
+def untestable(kin, model) -> str | None:
+    if model.law == "lugre":
+        return "the nominal model has LuGre bristles already"
+    if min(model.curve.positive.Fc, model.curve.negative.Fc) <= 0:
+        return "the nominal Coulomb level is zero: nothing builds up after reversals"
+    if np.count_nonzero(np.diff(np.sign(kin.vf[np.abs(kin.vf) > 0])) != 0) < 2:
+        return "fewer than two velocity reversals"
+    return None
+
+
 def design(kin, model, hyper):
-    v = kin.v
+    v = kin.vf
     a = np.abs(v)
     g_pos = model.curve.positive.level(a)
     g_neg = model.curve.negative.level(a)
@@ -61,7 +76,7 @@ def design(kin, model, hyper):
     g = np.where(v >= 0, g_pos, g_neg)
     z = _bristle(np.ascontiguousarray(v), float(kin.t[1] - kin.t[0]), g_pos, g_neg, s0)
     zdot = v - s0 * a * z / g
-    return kin.filtered(s0 * z + s1 * zdot - np.sign(v) * g)[:, None]
+    return kin.sliding(s0 * z + s1 * zdot - np.sign(v) * g)[:, None]
 
 
 def unphysical(theta, hyper, model) -> str | None:
@@ -79,3 +94,9 @@ def parameters(theta, hyper, model) -> dict:
 
 def extend(model, theta, hyper):
     return presliding.extend(model, np.array([1.0 / hyper["sigma0"]]), {})
+
+
+def sentence(p, inc, model) -> str:
+    Fc = min(model.curve.positive.Fc, model.curve.negative.Fc)
+    return (f"after each velocity reversal friction builds up over a slip of about {_q(Fc / p['sigma0'], None, 'm')} "
+            f"instead of jumping (LuGre bristles, sigma0 = {_q(p['sigma0'], None, 'N/m')})")

@@ -8,9 +8,14 @@ from dataclasses import replace
 import numpy as np
 
 from . import with_curves
+from ._words import _q
 
 NAME = "stribeck"
 DESCRIPTION = "velocity-weakening (Stribeck) shape: levels and vs"
+FAMILY = "low speed"
+HYPERS = 1
+HYPER_KEYS = ("vs",)
+UNITS = {"Fc": "N", "Fs": "N", "vs": "m/s"}
 
 
 def hypers(kin, model) -> list:
@@ -26,25 +31,28 @@ def hypers(kin, model) -> list:
 
 
 def design(kin, model, hyper):
-    s = np.sign(kin.v)
-    return kin.filtered(np.column_stack([s, s * np.exp(-(np.abs(kin.v) / hyper["vs"]) ** 2)]))
+    s = np.sign(kin.vf)
+    return kin.sliding(np.column_stack([s, s * np.exp(-(np.abs(kin.vf) / hyper["vs"]) ** 2)]))
 
 
 def shift(kin, model, hyper) -> np.ndarray:
     """The nominal dip Fs - Fc of each direction moved from its own shape to exp(-(|v|/vs)^2)
     [N] (n,): zero for a curve without a dip."""
-    v = kin.v
+    v = kin.vf
     out = np.zeros_like(v)
     for c, side in ((model.curve.positive, v > 0), (model.curve.negative, v < 0)):
         dip = c.Fs - c.Fc
         if dip:
             a = np.abs(v[side])
             out[side] = np.sign(v[side]) * dip * (np.exp(-(a / hyper["vs"]) ** 2) - np.exp(-(a / c.vs) ** c.beta))
-    return kin.filtered(out)
+    return kin.sliding(out)
 
 
 def unphysical(theta, hyper, model) -> str | None:
     dip = min(model.curve.positive.Fs - model.curve.positive.Fc, model.curve.negative.Fs - model.curve.negative.Fc)
+    Fc = min(model.curve.positive.Fc, model.curve.negative.Fc) + float(theta[0])
+    if Fc < 0:
+        return f"Fc = {Fc:.3g} N < 0"
     if dip + theta[1] < 0:
         return (f"Fs - Fc = {dip + theta[1]:.3g} N < 0 (friction rising with speed at low speed); a force dip at "
                 "low speed through reversals is frictional memory (lag) or presliding, not a Stribeck curve")
@@ -64,3 +72,10 @@ def extend(model, theta, hyper):
         return replace(c, Fc=Fc, Fs=Fc + (c.Fs - c.Fc) + float(theta[1]), vs=hyper["vs"], beta=2.0)
     out = with_curves(model, new)
     return out.replace(law="stribeck") if model.law == "coulomb-viscous" else out
+
+
+def sentence(p, inc, model) -> str:
+    c = model.curve.positive
+    return (f"friction at low speed differs from the model's: static level Fs = {_q(p['Fs'], None, 'N')} "
+            f"(model {_q(c.Fs, None, 'N')}), Coulomb level Fc = {_q(p['Fc'], None, 'N')} (model "
+            f"{_q(c.Fc, None, 'N')}), Stribeck velocity vs = {_q(p['vs'], None, 'm/s')} (model {_q(c.vs, None, 'm/s')})")

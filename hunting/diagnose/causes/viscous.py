@@ -2,9 +2,14 @@
 from dataclasses import replace
 
 from . import with_curves
+from ._words import _q
 
 NAME = "viscous"
 DESCRIPTION = "viscous coefficient b"
+FAMILY = "velocity"
+HYPERS = 0
+NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+UNITS = {"b": "N s/m"}
 
 
 def hypers(kin, model) -> list:
@@ -12,7 +17,12 @@ def hypers(kin, model) -> list:
 
 
 def design(kin, model, hyper):
-    return kin.filtered(kin.v)[:, None]
+    return kin.sliding(kin.vf)[:, None]
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    b = model.curve.positive.b + float(theta[0])
+    return f"b = {b:.3g} N s/m < 0 (friction that pushes along the motion)" if b < 0 else None
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -21,3 +31,10 @@ def parameters(theta, hyper, model) -> dict:
 
 def extend(model, theta, hyper):
     return with_curves(model, lambda c: replace(c, b=c.b + float(theta[0])))
+
+
+def sentence(p, inc, model) -> str:
+    b0 = model.curve.positive.b
+    ratio = p["b"] / b0 if b0 else float("inf")
+    return (f"viscous friction is {ratio:.3g} times the model's (b = {_q(p['b'], None, 'N s/m')} instead of "
+            f"{_q(b0, None, 'N s/m')})")

@@ -1,0 +1,211 @@
+"""Write the blind benchmark's datasets: per dataset a fitting and a validation record (the same
+system under two independent setpoint programmes and noise draws), the user's nominal model and
+the truth.
+
+Files per dataset directory ``dNNNN/``: ``fit.npz`` and ``val.npz`` (columns t [s], q [m], u,
+q_ref [m]: what ``hunting diagnose`` reads), ``model.json`` (the nominal model in the schema of
+``hunting diagnose --model``), ``truth.json`` (effects with sizes, accepted names, true parameters
+as final values and validation gains; the full true and nominal systems). ``index.json`` lists
+the datasets of a set.
+
+Sets are seed families: each dataset's random stream is ``default_rng([FAMILY, index,
+attempt])``; the tuning and reporting families never share a stream.
+
+    python -m benchmarks.blind.generate tuning /work/wt/blind-data/tuning
+    python -m benchmarks.blind.generate reporting /work/wt/blind-data/reporting
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import numpy as np
+
+from . import draw, measures, programme
+from .system import Sensor, nominal_json, run
+
+FAMILIES = {"tuning": 1, "reporting": 2, "test": 3}
+# (clean, single effect, two effects)
+SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0)}
+# the tests' subset: short records, the strong half of the size range, ten causes
+SHORT = ("test",)
+TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
+               "saturation")
+MAX_ATTEMPTS = 8
+VERSION = 2
+
+
+def plan(family: str, index: int, sizes=None) -> tuple[tuple, tuple]:
+    """(causes, size fractions) of dataset ``index`` of a family: clean first, then single
+    effects cycling through the causes with sizes stratified over [0, 1], then pairs."""
+    n_clean, n_one, n_two = SIZES[family] if sizes is None else sizes
+    rng = np.random.default_rng([FAMILIES[family], index, 10_000])
+    if index < n_clean:
+        return (), ()
+    j = index - n_clean
+    if family == "test" and j < n_one:
+        return (TEST_CAUSES[j % len(TEST_CAUSES)],), (0.6 + 0.4 * rng.random(),)
+    if j < n_one:
+        k = len(draw.CAUSES)
+        per = math.ceil(n_one / k)
+        stratum = j // k
+        # a per-cause permutation of the strata, so every cause covers the size range
+        perm = np.random.default_rng([FAMILIES[family], 20_000 + j % k]).permutation(per)
+        return (draw.CAUSES[j % k],), ((perm[stratum] + rng.random()) / per,)
+    pairs = [(a, b) for i, a in enumerate(draw.CAUSES) for b in draw.CAUSES[i + 1:] if draw.compatible(a, b)]
+    a, b = pairs[int(rng.integers(len(pairs)))]
+    return (a, b), (float(rng.random()), float(rng.random()))
+
+
+def _records(d: draw.Draft, rng, attempt_rng):
+    """Fit and validation references and noises, and the true runs (saturation fixed from the
+    unsaturated peaks when an effect or the nominal model asks for one)."""
+    refs, noises = [], []
+    for _ in range(2):
+        r, segs = programme.draw(attempt_rng, d.duration, d.dt, d.stroke, d.speed)
+        n = r.size
+        refs.append((r, segs))
+        noises.append((d.noise.draw(n, d.dt, attempt_rng), d.sensor.noise * attempt_rng.standard_normal(n)))
+    if d.needs_saturation or d.known_saturation:
+        free = replace(d.ctrl, saturation=math.inf)
+        peaks = [np.max(np.abs(run(d.plant, free, d.sensor, r, d.dt, i, s).u)) for (r, _), (i, s) in zip(refs, noises)]
+        known = float(d.known_saturation * min(peaks)) if d.known_saturation else math.inf
+        hidden = float(d.needs_saturation * min(peaks)) if d.needs_saturation else math.inf
+
+        def fix(c):
+            return replace(c, saturation=hidden if c.saturation < 0 else known)
+        d.ctrl, d.nominal_ctrl = fix(d.ctrl), fix(d.nominal_ctrl)
+        d.isolated = [(p, fix(c)) for p, c in d.isolated]
+        for e in d.effects:
+            if e["cause"] == "saturation":
+                e["params"] = {"saturation": hidden}
+    recs = [run(d.plant, d.ctrl, d.sensor, r, d.dt, i, s) for (r, _), (i, s) in zip(refs, noises)]
+    return refs, recs
+
+
+def gains(d: draw.Draft, val_ref: np.ndarray, val_rec, isolated: list) -> list:
+    """[(force gain, behaviour gain)] per effect, then the joint one (the true plant)."""
+    kin = measures.Kin(val_rec.t, val_rec.q, val_rec.u, d.nominal.cm)
+    r_nom = measures.residual(kin, d.nominal)
+    # noise-free re-simulations of the validation reference
+    sens = Sensor(d.sensor.resolution, 0.0)
+    q_nom = run(d.nominal, d.nominal_ctrl, sens, val_ref, d.dt).q
+    out = []
+    for plant, ctrl in isolated + [(d.plant, d.ctrl)]:
+        fg = measures.force_gain(kin, d.nominal, plant, r_nom)
+        q_e = run(plant, ctrl, sens, val_ref, d.dt).q
+        out.append((float(fg), float(measures.behaviour_gain(val_rec.q, q_nom, q_e))))
+    return out
+
+
+def _sane(d: draw.Draft, recs) -> str | None:
+    for rec in recs:
+        if rec.status != 0:
+            return rec.message
+        err = np.max(np.abs(rec.q - rec.r))
+        if not err < 2 * d.stroke:
+            return f"tracking error {err:.3g} m exceeds twice the stroke {d.stroke:.3g} m (unstable loop)"
+        if np.all(rec.stuck[rec.t > 0.3]):
+            return "the mass never moves"
+    return None
+
+
+def make(family: str, index: int, sizes=None) -> tuple[dict, dict, dict]:
+    """Dataset ``index`` of ``family``: (files {name: arrays or dict}, truth, index row)."""
+    causes, fracs = plan(family, index, sizes)
+    why = []
+    for attempt in range(MAX_ATTEMPTS):
+        rng = np.random.default_rng([FAMILIES[family], index, attempt])
+        d = draw.draft(rng, causes, fracs, short=family in SHORT)
+        refs, recs = _records(d, rng, rng)
+        bad = _sane(d, recs)
+        if bad is None:
+            break
+        why.append(bad)
+    else:
+        raise RuntimeError(f"{family} dataset {index}: no sane draw in {MAX_ATTEMPTS} attempts: {why}")
+    g = gains(d, refs[1][0], recs[1], d.isolated)
+    for e, (fg, bg) in zip(d.effects, g):
+        e["gain_force"], e["gain_behaviour"] = fg, bg
+        e["gain"] = draw.size_gain(e["cause"], fg, bg)
+    files = {}
+    for name, (r, segs), rec in zip(("fit", "val"), refs, recs):
+        files[name] = dict(t=rec.t, q=rec.q, u=rec.u, q_ref=r)
+    files["model"] = nominal_json(d.nominal, d.nominal_ctrl, d.sensor)
+    truth = dict(version=VERSION, family=family, index=index, attempt=attempt, rejected_draws=why,
+                 causes=[e["cause"] for e in d.effects], effects=d.effects,
+                 joint_gain={"force": g[-1][0], "behaviour": g[-1][1]},
+                 setup=dict(dt=d.dt, duration=d.duration, stroke=d.stroke, speed=d.speed, bandwidth=d.bandwidth,
+                            samples=int(recs[0].t.size)),
+                 true=dict(plant=asdict(d.plant), controller=asdict(d.ctrl)),
+                 nominal=dict(plant=asdict(d.nominal), controller=asdict(d.nominal_ctrl)),
+                 sensor=asdict(d.sensor), noise=asdict(d.noise),
+                 programmes={"fit": refs[0][1], "val": refs[1][1]})
+    row = dict(id=f"d{index:04d}", causes=truth["causes"])
+    return files, truth, row
+
+
+def write(family: str, out: Path, indices=None, sizes=None, progress: bool = True) -> list:
+    """Generate the datasets of a family into ``out`` (cached: an existing dataset of the same
+    version is kept). Returns the index rows."""
+    from tqdm import tqdm
+    out.mkdir(parents=True, exist_ok=True)
+    n = sum(SIZES[family] if sizes is None else sizes)
+    rows = []
+    for i in tqdm(range(n) if indices is None else indices, desc=f"generate {family}", disable=not progress):
+        dd = out / f"d{i:04d}"
+        tf = dd / "truth.json"
+        if tf.is_file():
+            t = json.loads(tf.read_text())
+            if t.get("version") == VERSION:
+                rows.append(dict(id=dd.name, causes=t["causes"]))
+                continue
+        files, truth, row = make(family, i, sizes)
+        dd.mkdir(exist_ok=True)
+        for name in ("fit", "val"):
+            np.savez(dd / f"{name}.npz", **files[name])
+        (dd / "model.json").write_text(json.dumps(files["model"], indent=1, default=_json))
+        (dd / "truth.json").write_text(json.dumps(_finite(truth), indent=1, default=_json))
+        rows.append(row)
+    every = [dict(id=p.parent.name, causes=json.loads(p.read_text())["causes"]) for p in sorted(out.glob("d*/truth.json"))]
+    (out / "index.json").write_text(json.dumps(dict(family=family, version=VERSION, datasets=every), indent=1))
+    return rows
+
+
+def _json(x):
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    raise TypeError(f"{type(x)} is not JSON serializable")
+
+
+def _finite(x):
+    """x with infinite floats (a controller without saturation) as None, for strict JSON."""
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    if isinstance(x, (float, np.floating)) and not math.isfinite(x):
+        return None
+    return x
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("family", choices=sorted(FAMILIES))
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--first", type=int, default=0)
+    ap.add_argument("--count", type=int, default=None)
+    a = ap.parse_args(argv)
+    n = sum(SIZES[a.family])
+    idx = range(a.first, n if a.count is None else min(n, a.first + a.count))
+    write(a.family, a.out, idx)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,41 @@
+"""Numbers in engineering form for the reports: rounded values with SI prefixes and units, a
+value with its standard uncertainty rounded to the uncertainty's second digit."""
+import math
+
+_PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"))
+_PREFIXED = {"m", "s", "N", "Hz", "V", "m/s", "N/m"}
+
+
+def _scale(value: float, unit: str) -> tuple[float, str]:
+    """(factor, prefixed unit) so that value / factor lies in [1, 1000) for units that take a
+    prefix (m, s, N, Hz, V, m/s, N/m); (1, unit) otherwise."""
+    if unit not in _PREFIXED or value == 0 or not math.isfinite(value):
+        return 1.0, unit
+    a = abs(value)
+    for f, p in _PREFIXES:
+        if a >= f * 0.9995:
+            break
+    if unit == "N" and f < 1e-3:          # uN and nN read oddly for forces on a machine: mN at most
+        f, p = 1e-3, "m"
+    return f, p + unit
+
+
+def _q(value, sigma, unit: str, digits: int = 3) -> str:
+    """'1.23 mm', '-0.1265 +- 0.0004 N' (sigma: standard uncertainty or None)."""
+    if value is None or not math.isfinite(float(value)):
+        return f"{value} {unit}".strip()
+    value = float(value)
+    ref = abs(value) if value else (abs(sigma) if sigma else 0.0)
+    f, u = _scale(ref, unit)
+    v = value / f
+    if sigma is not None and math.isfinite(sigma) and sigma > 0:
+        s = sigma / f
+        dec = max(0, 1 - int(math.floor(math.log10(s))))
+        return f"{v:.{dec}f} ± {s:.{dec}f} {u}".strip()
+    return f"{v:.{digits}g} {u}".strip()
+
+
+def _pct(x: float) -> str:
+    """A share as a percentage with two significant digits ('48 %', '3.1 %')."""
+    p = 100 * x
+    return f"{p:.2g} %" if p < 10 else f"{p:.0f} %"

@@ -1,0 +1,471 @@
+"""The force channel: which combination of causes explains the force residual.
+
+Every force-channel cause is linear in its parameters once its hyper-parameters (a cogging
+pitch, a Stribeck velocity, a slip length, a resonance) are fixed, so an explanation (a set of
+causes, each at one hyper-parameter variant) is a least-squares fit of the nominal residual.
+
+Search (fitting data): every set of at most ``max_causes`` causes, each member at its best
+variant given the others (coordinate descent over the variants), scored by BIC on the thinned,
+prewhitened residual (:mod:`hunting.diagnose.stats`):
+
+    BIC = m log(RSS_w / m) + (coefficients + hyper-parameters searched) log m
+
+The noise model of the prewhitening is fitted on the residual of the whole library (every
+testable cause at its best variant at once): a residual that contains no candidate effect, so
+that a strong effect does not pass for noise (the old lag-1 rule collapsed exactly then).
+
+Acceptance (validation data): each member c of the best set must (1) explain the validation
+residual of the set without c out of sample, p < alpha (:func:`stats.out_of_sample`), and (2)
+grow the validation RMS by at least ``min_gain`` (relative) when dropped, and by more than
+``PRECISION`` of the drive force's RMS (absolute: a model that reproduces the data to numerical
+precision has nothing left to explain; on noise-free records of the nominal model itself a
+residual of 1e-5 of the drive force otherwise passed as a 150 ns "delay"). Members that fail are
+removed one at a time (the smallest gain first) and the rest refitted. What remains is the
+explanation; the sets that came next in BIC and the causes of the same family (shared
+signature) that would replace a selected one are its alternatives."""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .causes import CAUSES
+from .kinematics import Kinematics, residual
+from .model import NominalModel
+from .stats import NoiseModel, Samples, gls, out_of_sample
+
+PRECISION = 1e-4      # a cause must remove more than this fraction of the drive force's RMS
+
+
+@dataclass
+class Variant:
+    """One hyper-parameter variant of a cause: its regressors on the fitting and validation
+    records (n, k) and the known, unfitted force change (n,) (zeros without one); Xr, sr : the
+    same on the validation record's reference trajectory (None without one)."""
+
+    name: str
+    hyper: dict
+    Xf: np.ndarray
+    Xv: np.ndarray
+    sf: np.ndarray
+    sv: np.ndarray
+    Xr: np.ndarray | None = None
+    sr: np.ndarray | None = None
+
+
+@dataclass
+class Explanation:
+    """A set of causes at chosen variants, fitted on the fitting data: members (name, variant
+    index); theta (all coefficients, in member order); bic; rss (whitened)."""
+
+    members: tuple
+    theta: np.ndarray
+    bic: float
+    rss: float
+    cols: list = field(default_factory=list)
+    unphysical: dict = field(default_factory=dict)
+
+    @property
+    def physical(self) -> bool:
+        return not self.unphysical
+
+    @property
+    def names(self) -> tuple:
+        return tuple(n for n, _ in self.members)
+
+
+class Library:
+    """Every testable force-channel cause with its variants, and the whitened Gram matrix of
+    all their regressors on the thinned fitting data."""
+
+    def __init__(self, names, kf: Kinematics, kv: Kinematics, model: NominalModel, used_f, used_v, step: int,
+                 kr: Kinematics | None = None):
+        self.model = model
+        self.kf, self.kv, self.kr = kf, kv, kr
+        self.untested: dict = {}
+        self.variants: dict = {}
+        self.rf = residual(kf, model)
+        self.rv = residual(kv, model)
+        self.used_f, self.used_v = used_f, used_v
+        self.Sf, self.Sv = Samples.thin(used_f, step), Samples.thin(used_v, step)
+        for name in names:
+            mod = CAUSES[name]
+            why = getattr(mod, "untestable", lambda *a: None)(kf, model)
+            why = why or getattr(mod, "untestable", lambda *a: None)(kv, model)
+            if why:
+                self.untested[name] = why
+                continue
+            hy = mod.hypers(kf, model)
+            if not hy:
+                self.untested[name] = "no hyper-parameter candidate in this record"
+                continue
+            self.variants[name] = [self.variant(name, h) for h in hy]
+        self._index()
+
+    def variant(self, name: str, hyper: dict) -> Variant:
+        """A cause's regressors and shifts at one hyper-parameter variant on both records."""
+        mod = CAUSES[name]
+        shift = getattr(mod, "shift", None)
+        kf, kv, kr, model = self.kf, self.kv, self.kr, self.model
+        v = Variant(name, hyper, mod.design(kf, model, hyper), mod.design(kv, model, hyper),
+                    shift(kf, model, hyper) if shift else np.zeros(kf.t.size),
+                    shift(kv, model, hyper) if shift else np.zeros(kv.t.size))
+        if kr is not None:
+            v.Xr = mod.design(kr, model, hyper)
+            v.sr = shift(kr, model, hyper) if shift else np.zeros(kr.t.size)
+        return v
+
+    # --- the thinned, whitened design of every variant -------------------------------------
+    def _index(self):
+        idx = self.Sf.idx
+        cols, shifts, self.slot = [], [], {}
+        c = 0
+        for name, vs in self.variants.items():
+            for j, v in enumerate(vs):
+                k = v.Xf.shape[1]
+                self.slot[(name, j)] = (list(range(c, c + k)), len(shifts) if np.any(v.sf) else None)
+                cols.append(v.Xf[idx])
+                c += k
+                if np.any(v.sf):
+                    shifts.append(v.sf[idx])
+        self.n_cols = c
+        X = np.column_stack(cols) if cols else np.zeros((idx.size, 0))
+        S = np.column_stack(shifts) if shifts else np.zeros((idx.size, 0))
+        y = self.rf[idx]
+        # the noise model from the residual of the whole library (each cause at its best variant
+        # alone): what no candidate explains
+        best = [self.best_alone(name, X, S, y) for name in self.variants]
+        full = [i for b in best for i in self.slot[b][0]]
+        sh = [self.slot[b][1] for b in best if self.slot[b][1] is not None]
+        yy = y - (S[:, sh].sum(axis=1) if sh else 0.0)
+        th, *_ = np.linalg.lstsq(X[:, full], yy, rcond=None) if full else (np.zeros(0),)
+        e = yy - (X[:, full] @ th if full else 0.0)
+        self.noise = NoiseModel.fit(e, self.Sf.run)
+        self.library_members = best
+        Z = np.column_stack([X, S, y])
+        Zw, self.run_w = self.noise.whiten(Z, self.Sf.run)
+        self.m = Zw.shape[0]
+        self.G = Zw.T @ Zw
+        self.X_thin, self.S_thin, self.y_thin = X, S, y
+
+    def best_alone(self, name, X, S, y) -> tuple:
+        """(name, variant index) fitting y best on its own (unwhitened, thinned samples); ties
+        within 0.1 % go to the first (simplest) variant."""
+        fits = []
+        for j in range(len(self.variants[name])):
+            cols, s = self.slot[(name, j)]
+            yy = y - (S[:, s] if s is not None else 0.0)
+            th, *_ = np.linalg.lstsq(X[:, cols], yy, rcond=None)
+            fits.append(float(np.sum((yy - X[:, cols] @ th) ** 2)))
+        lo = min(fits)
+        return name, next(j for j, f in enumerate(fits) if f <= lo * (1 + 1e-3))
+
+    # --- fits of explanations ---------------------------------------------------------------
+    def fit(self, members) -> Explanation:
+        """Least squares of an explanation on the whitened thinned fitting data (via the Gram
+        matrix) and its BIC."""
+        cols, sh = [], []
+        for m in members:
+            c, s = self.slot[m]
+            cols += c
+            if s is not None:
+                sh.append(self.n_cols + s)
+        G, iy = self.G, self.G.shape[0] - 1
+        yy = G[iy, iy] - 2 * sum(G[iy, s] for s in sh) + sum(G[s, t] for s in sh for t in sh)
+        if cols:
+            A = G[np.ix_(cols, cols)]
+            b = G[cols, iy] - (G[np.ix_(cols, sh)].sum(axis=1) if sh else 0.0)
+            theta = np.linalg.lstsq(A, b, rcond=None)[0]
+            rss = float(yy - theta @ b)
+        else:
+            theta, rss = np.zeros(0), float(yy)
+        rss = max(rss, 1e-300 * max(yy, 1.0))
+        hyp = sum(CAUSES[n].HYPERS for n, _ in members)
+        bic = self.m * np.log(rss / self.m) + (len(cols) + hyp) * np.log(self.m)
+        return Explanation(tuple(members), theta, float(bic), rss, cols, _unphysical(self, members, theta))
+
+    def best_variants(self, names, start=None) -> Explanation:
+        """The explanation with the causes ``names``, each at its best variant given the others
+        (two passes of coordinate descent from ``start`` or each cause's best alone)."""
+        cur = dict(start or {})
+        for n in names:
+            cur.setdefault(n, dict(self.library_members)[n])
+        for _ in range(2):
+            changed = False
+            for n in names:
+                if len(self.variants[n]) == 1:
+                    continue
+                fits = [self.fit([(m, (j if m == n else cur[m])) for m in names]) for j in range(len(self.variants[n]))]
+                ok = [f.rss if f.physical else np.inf for f in fits]
+                lo = min(ok)
+                if not np.isfinite(lo):
+                    continue                   # no variant is physical: keep the current one
+                j = next(j for j, f in enumerate(ok) if f <= lo * (1 + 1e-6) + 1e-300)
+                changed |= j != cur[n]
+                cur[n] = j
+            if not changed:
+                break
+        return self.fit([(n, cur[n]) for n in names])
+
+    # --- predictions ------------------------------------------------------------------------
+    def prediction(self, ex: Explanation, which: str) -> np.ndarray:
+        """The explanation's force change (n,) on the fitting ("f") or validation ("v") record, or
+        along the validation record's reference trajectory ("r")."""
+        n = (self.rf if which == "f" else self.rv).size
+        out = np.zeros(n)
+        k = 0
+        for name, j in ex.members:
+            v = self.variants[name][j]
+            X, s = {"f": (v.Xf, v.sf), "v": (v.Xv, v.sv), "r": (v.Xr, v.sr)}[which]
+            out += X @ ex.theta[k:k + X.shape[1]] + s
+            k += X.shape[1]
+        return out
+
+    def part(self, ex: Explanation, name: str, which: str) -> np.ndarray:
+        """One member's force change (n,) in a fitted explanation (prediction's terms)."""
+        k = 0
+        for nm, j in ex.members:
+            v = self.variants[nm][j]
+            kk = v.Xf.shape[1]
+            if nm == name:
+                X, s = {"f": (v.Xf, v.sf), "v": (v.Xv, v.sv), "r": (v.Xr, v.sr)}[which]
+                return X @ ex.theta[k:k + kk] + s
+            k += kk
+        raise KeyError(name)
+
+    def validation_rms(self, ex: Explanation) -> float:
+        r = (self.rv - self.prediction(ex, "v"))[self.used_v]
+        return float(np.sqrt(np.mean(r ** 2)))
+
+
+def _rms(x) -> float:
+    return float(np.sqrt(np.mean(np.asarray(x) ** 2)))
+
+
+def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_reference: float = 0.01) -> dict:
+    """The force channel's explanation (module docstring): {"explanation", "tests" (per member:
+    gamma, t, p, gain, rms without), "rejected" (rows), "ranking" (every set searched, best
+    first: (bic, names)), "noise_val"}."""
+    names = list(lib.variants)
+    sets = [()]
+    for k in range(1, min(max_causes, len(names)) + 1):
+        sets += [s for s in itertools.combinations(names, k) if compatible(s)]
+    fits = {s: lib.best_variants(s) for s in sets}
+    ranking = sorted((e for e in fits.values() if e.physical), key=lambda e: e.bic)
+    rejected = [dict(name=n, step="search", statistic=None, p_value=None, validation_gain=None,
+                     reason=f"the fitted extension is not physical: {fits[(n,)].unphysical[n]}")
+                for n in names if not fits[(n,)].physical]
+    # the validation noise model: the whole library's validation residual, fitted coefficients
+    full = lib.best_variants(tuple(names))
+    Sv = lib.Sv
+    e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
+    noise_v = NoiseModel.fit(e_full, Sv.run)
+    current = ranking[0]
+    floor = PRECISION * float(np.sqrt(np.mean(lib.kv.force[lib.used_v] ** 2)))
+    while True:
+        tests = {}
+        rms_full = lib.validation_rms(current)
+        pred = lib.prediction(current, "v")
+        for name in current.names:
+            rest = tuple(n for n in current.names if n != name)
+            start = {n: j for n, j in current.members if n != name}
+            without = lib.best_variants(rest, start) if rest else lib.fit([])
+            # the test: does this cause's part of the fitted explanation (the others' parts held)
+            # predict the validation residual the others leave?
+            own = lib.part(current, name, "v")
+            e0 = (lib.rv - pred + own)[Sv.idx]
+            gamma, t, p = out_of_sample(e0, own[Sv.idx], Sv.run, noise_v)
+            # the gain: the explanation refitted without it
+            rms_wo = lib.validation_rms(without)
+            tests[name] = dict(gamma=gamma, t=t, p_value=p, gain=rms_wo / max(rms_full, 1e-300) - 1,
+                               rms_without=rms_wo, rms=rms_full, bic_without=without.bic, floor=floor)
+            if lib.kr is not None and getattr(CAUSES[name], "NOISE_FED", False):
+                # the same part along the instrument trajectory: free of the sensor's and the
+                # actuator's noise, which feedback puts into the measured regressors (a delay or
+                # mass "explaining" the loop's reaction to its own noise explains nothing here)
+                yr = lib.part(current, name, "r")[Sv.idx]
+                tests[name]["p_reference"] = out_of_sample(e0, yr, Sv.run, noise_v)[2]
+        failing = [n for n in current.names if tests[n]["p_value"] >= alpha or tests[n]["gain"] < min_gain
+                   or tests[n].get("p_reference", 0.0) >= alpha_reference
+                   or tests[n]["rms_without"] - tests[n]["rms"] <= floor]
+        if failing:
+            worst = min(failing, key=lambda n: tests[n]["gain"])
+            rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
+                                 p_value=tests[worst]["p_value"], validation_gain=tests[worst]["gain"],
+                                 reason=_why(tests[worst], alpha, min_gain, alpha_reference)))
+            current = _physical_subset(lib, fits, tuple(n for n in current.names if n != worst), rejected)
+            continue
+        # the whole set must also beat every smaller set of its causes by min_gain (two causes
+        # fitted together can each look needed beside the other and still be worse than
+        # neither): else the largest such set (best BIC among equals) replaces it
+        beaten = []
+        for k in range(len(current.names) - 1):
+            for sub in itertools.combinations(current.names, k):
+                alt = fits.get(sub) or lib.best_variants(sub)
+                rms_sub = lib.validation_rms(alt)
+                if (rms_sub < (1 + min_gain) * rms_full or rms_sub - rms_full <= floor) and alt.physical:
+                    beaten.append((len(sub), -alt.bic, sub, rms_sub, alt))
+        if not beaten:
+            break
+        _, _, sub, rms_sub, alt = max(beaten, key=lambda b: (b[0], b[1]))
+        for name in current.names:
+            if name not in sub:
+                rejected.append(dict(name=name, step="validation", statistic=tests[name]["t"],
+                                     p_value=tests[name]["p_value"], validation_gain=tests[name]["gain"],
+                                     reason="with it the explanation does not beat {{{}}} on the validation data by {:.0%} "
+                                            "({:.4g} against {:.4g} N RMS)".format(", ".join(sub) or "nominal model",
+                                                                                    min_gain, rms_full, rms_sub)))
+        current = alt
+    # one row per cause: the last verdict (a cause unphysical alone may be rejected later on the
+    # validation data inside a larger set); causes never in the best set say how they fared alone
+    last = {r["name"]: r for r in rejected}
+    rms0 = lib.validation_rms(fits[()])
+    for name in names:
+        if name in last or name in current.names:
+            continue
+        alone = fits[(name,)]
+        gain = 1 - lib.validation_rms(alone) / max(rms0, 1e-300)
+        last[name] = dict(name=name, step="search", statistic=None, p_value=None, validation_gain=gain,
+                          reason=f"not in the best explanation: alone it changes the fitting data's BIC by "
+                                 f"{alone.bic - fits[()].bic:+.1f} and the validation residual by {-gain:+.1%}")
+    return dict(explanation=current, tests=tests if current.members else {}, rejected=list(last.values()),
+                ranking=ranking, noise_val=noise_v, fits=fits)
+
+
+def compatible(names) -> bool:
+    """No cause of the set excludes another (``EXCLUDES``: a special case of it, or a model that
+    cannot hold both)."""
+    return not any(o in names for n in names for o in getattr(CAUSES[n], "EXCLUDES", ()))
+
+
+def _physical_subset(lib: Library, fits: dict, names: tuple, rejected: list) -> Explanation:
+    """The explanation with the causes ``names``, without those whose fitted extension is not
+    physical in it (removed one at a time, each with a rejected row)."""
+    while True:
+        ex = fits.get(names) or lib.best_variants(names)
+        if ex.physical:
+            return ex
+        name, why = next(iter(ex.unphysical.items()))
+        rejected.append(dict(name=name, step="validation", statistic=None, p_value=None, validation_gain=None,
+                             reason=f"the fitted extension is not physical beside {', '.join(n for n in names if n != name)}: "
+                                    f"{why}"))
+        names = tuple(n for n in names if n != name)
+
+
+def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) -> str:
+    out = []
+    if t["p_value"] >= alpha:
+        out.append(f"not significant out of sample (p = {t['p_value']:.2g} >= {alpha:g})")
+    if t.get("p_reference", 0.0) >= alpha_reference:
+        out.append(f"its prediction along the reference trajectory does not explain the validation data "
+                   f"(p = {t['p_reference']:.2g} >= {alpha_reference:g}): the loop's reaction to its own noise")
+    if t["gain"] < min_gain:
+        out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
+    if 0.0 <= t["rms_without"] - t["rms"] <= t["floor"]:     # a cause that makes it worse has its reason above
+        out.append(f"it removes {t['rms_without'] - t['rms']:.2g} N RMS of the validation residual, not more than "
+                   f"{PRECISION:g} of the drive force's RMS ({t['floor']:.2g} N): the model already reproduces the "
+                   "data to numerical precision")
+    return " and ".join(out)
+
+
+def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: float = 0.25):
+    """Gauss-Newton refinement of the continuous hyper-parameters (``HYPER_KEYS`` of a cause:
+    a pitch, a Stribeck velocity, a bristle stiffness, a resonance) of an explanation's members
+    in log scale, from their grid values; returns (explanation, theta, cov, hyper sigmas {name:
+    {key: sigma}}). theta and cov come from the GLS fit (:func:`stats.gls`) with the hyper-
+    parameters' sensitivity columns appended (their covariance is the delta method's)."""
+    idx, run, noise = lib.Sf.idx, lib.Sf.run, lib.noise
+    members = list(ex.members)
+    bounds = {}
+    for name, _ in members:
+        mod = CAUSES[name]
+        b = getattr(mod, "hyper_bounds", None)
+        b = b(lib.kf, lib.model) if b else {}
+        for key in getattr(mod, "HYPER_KEYS", ()):
+            if key not in b:        # the range of the variants searched, 3 % wider
+                vals = [v.hyper[key] for v in lib.variants[name]]
+                b[key] = (min(vals) / 1.03, max(vals) * 1.03)
+        bounds[name] = b
+    keys = [(name, k) for name, _ in members for k in getattr(CAUSES[name], "HYPER_KEYS", ())]
+
+    def design(mem):
+        X, s = [], np.zeros(idx.size)
+        for name, j in mem:
+            v = lib.variants[name][j]
+            X.append(v.Xf[idx])
+            s = s + v.sf[idx]
+        return (np.column_stack(X) if X else np.zeros((idx.size, 0))), s
+
+    def sensitivities(mem, theta):
+        """d(force change)/d(log h) per hyper key: central differences at +-1 %."""
+        cols, k = [], 0
+        for name, j in mem:
+            v = lib.variants[name][j]
+            kk = v.Xf.shape[1]
+            for key in getattr(CAUSES[name], "HYPER_KEYS", ()):
+                out = []
+                for f in (1.01, 1 / 1.01):
+                    h = dict(v.hyper, **{key: v.hyper[key] * f})
+                    mod = CAUSES[name]
+                    x = mod.design(lib.kf, lib.model, h)[idx] @ theta[k:k + kk]
+                    sh = getattr(mod, "shift", None)
+                    out.append(x + (sh(lib.kf, lib.model, h)[idx] if sh else 0.0))
+                cols.append((out[0] - out[1]) / (2 * np.log(1.01)))
+            k += kk
+        return np.column_stack(cols) if cols else np.zeros((idx.size, 0))
+
+    X, s = design(members)
+    theta, cov, rss, _ = gls(X, lib.y_thin - s, run, noise) if X.shape[1] else (np.zeros(0), np.zeros((0, 0)), 0.0, 0)
+    for _ in range(iterations if keys else 0):
+        G = sensitivities(members, theta)
+        th_aug, _, _, _ = gls(np.column_stack([X, G]), lib.y_thin - s, run, noise)
+        step = np.clip(th_aug[X.shape[1]:], -max_step, max_step)
+        if np.all(np.abs(step) < 1e-3):
+            break
+        trial, i = [], 0
+        for name, j in members:
+            v = lib.variants[name][j]
+            h = dict(v.hyper)
+            for key in getattr(CAUSES[name], "HYPER_KEYS", ()):
+                lo, hi = bounds[name][key]
+                h[key] = float(np.clip(v.hyper[key] * np.exp(step[i]), lo, hi))
+                i += 1
+            if h != v.hyper:
+                lib.variants[name].append(lib.variant(name, h))
+                j = len(lib.variants[name]) - 1
+            trial.append((name, j))
+        Xt, st = design(trial)
+        tt, ct, rt, _ = gls(Xt, lib.y_thin - st, run, noise)
+        if rt < rss and not _unphysical(lib, trial, tt):
+            members, X, s, theta, cov, rss = trial, Xt, st, tt, ct, rt
+        else:
+            break
+    sig = {}
+    if keys:
+        G = sensitivities(members, theta)
+        _, cov_aug, _, _ = gls(np.column_stack([X, G]), lib.y_thin - s, run, noise)
+        k = X.shape[1]
+        i = 0
+        for name, j in members:
+            for key in getattr(CAUSES[name], "HYPER_KEYS", ()):
+                h = lib.variants[name][j].hyper[key]
+                sig.setdefault(name, {})[key] = float(h * np.sqrt(max(cov_aug[k + i, k + i], 0.0)))
+                i += 1
+        # the linear parameters' covariance with the hyper-parameters free
+        cov = cov_aug[:k, :k]
+    cols = list(range(X.shape[1]))
+    return Explanation(tuple(members), theta, ex.bic, rss, cols), theta, cov, sig
+
+
+def _unphysical(lib: Library, members, theta) -> dict:
+    """{name: why} for the members whose fitted extension is not physical."""
+    why, k = {}, 0
+    for name, j in members:
+        v = lib.variants[name][j]
+        kk = v.Xf.shape[1]
+        w = getattr(CAUSES[name], "unphysical", lambda *a: None)(theta[k:k + kk], v.hyper, lib.model)
+        if w:
+            why[name] = w
+        k += kk
+    return why

@@ -1,0 +1,76 @@
+"""Checks of measured data against the model before a diagnosis: the sample rate against the
+model's time constants, the units of the force balance. A record that cannot support a diagnosis
+is an error naming what to change; one that supports it only in part gives notes (the causes a
+record is too short for are listed by the causes themselves as untested)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import SystemDefinitionError
+from .data import Measurement
+from .model import NominalModel
+
+MIN_RATE_RATIO = 10.0      # the sample rate must exceed the loop bandwidth this many times
+MAX_FORCE_RATIO = 30.0     # the model's inertia or friction force against the measured drive force
+
+
+def loop_bandwidth(model: NominalModel) -> float | None:
+    """The closed loop's bandwidth [Hz] from the controller's gains and the mass (None without a
+    controller): the larger of the stiffness frequency sqrt(kp cm / m) and the damping rate
+    kd cm / m of a PID (2 pi rad/s per Hz), or of kv cm / m and kp for the PD + velocity loop."""
+    c = model.controller
+    if not c:
+        return None
+    from .resimulate import SampledController
+    ctrl = SampledController.from_schema(c)
+    m, cm = model.mass, model.cm
+    if ctrl.kind == "pd-velocity-loop":
+        w = max(abs(ctrl.kv) * cm / m, abs(ctrl.kp))
+    else:
+        w = max(math.sqrt(abs(ctrl.kp) * cm / m), abs(ctrl.kd) * cm / m)
+    return w / (2 * math.pi) if w > 0 else None
+
+
+def check_inputs(fit: Measurement, validate: Measurement, model: NominalModel) -> list:
+    """Errors for data the model cannot be judged on; notes (list of str) for what is doubtful."""
+    notes = []
+    for meas in (fit, validate):
+        dt = meas.dt
+        ts = (model.controller or {}).get("sample_time")
+        if ts is not None and dt > 1.0001 * float(ts):
+            raise SystemDefinitionError(
+                f"{meas.name}: sampled every {dt:.3g} s, slower than the model's controller (sample_time {ts:g} s): "
+                "the data cannot show what the controller does between samples; give data at the controller's rate")
+    f_bw = loop_bandwidth(model)
+    if f_bw:
+        fs = 1.0 / fit.dt
+        if fs < MIN_RATE_RATIO * f_bw:
+            raise SystemDefinitionError(
+                f"{fit.name}: sampled at {fs:.4g} Hz, less than {MIN_RATE_RATIO:g} times the model's loop bandwidth "
+                f"{f_bw:.3g} Hz: the smoothed acceleration cannot follow the loop; record faster (or check that t is "
+                "in seconds)")
+        if fs > 1e5 * f_bw:
+            notes.append(f"the data are sampled at {fs:.4g} Hz, {fs / f_bw:.3g} times the model's loop bandwidth "
+                         f"{f_bw:.3g} Hz: is t in seconds?")
+    return notes
+
+
+def check_units(kin, model: NominalModel, name: str) -> None:
+    """An error when the model's inertia force m a or friction force F(v) on the sliding samples
+    is more than MAX_FORCE_RATIO times the measured drive force: the data and the model then
+    disagree in their units (most often the time column: a in m/s^2 scales with its square)."""
+    m = kin.moving
+    if m.sum() < 10:
+        return
+    drive = float(np.sqrt(np.mean(kin.force[m] ** 2)))
+    inertia = float(np.sqrt(np.mean((model.mass * kin.a[m]) ** 2)))
+    friction = float(np.sqrt(np.mean(model.friction(kin.v[m]) ** 2)))
+    worst, label = max((inertia, "inertia force m a"), (friction, "friction force F(v)"))
+    if worst > MAX_FORCE_RATIO * max(drive, 1e-300):
+        raise SystemDefinitionError(
+            f"{name}: the model's {label} (RMS {worst:.3g} N) is {worst / max(drive, 1e-300):.3g} times the measured "
+            f"drive force cm u (RMS {drive:.3g} N): the data and the model disagree in their units. Check the time "
+            f"column (t in seconds: these data are sampled at {1 / float(kin.t[1] - kin.t[0]):.4g} Hz), the position "
+            "unit (m or rad) and the motor constant")

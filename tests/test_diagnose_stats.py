@@ -1,0 +1,94 @@
+"""The diagnosis' tests hold their false-alarm rate on correlated residuals: noise with no effect
+in it (AR(1) near a unit root, a lightly damped AR(2), noise whose level follows the
+acceleration), passed through the acceleration's filter like a real force residual, against the
+regressors of real causes on a stroke programme. The out-of-sample test must reject at most at
+its nominal level; the plain least-squares t test must not (else this test could not tell a
+calibrated rule from a broken one)."""
+import numpy as np
+import pytest
+from scipy import stats as st
+from scipy.signal import lfilter
+
+from hunting.diagnose import Measurement, NominalModel, kinematics
+from hunting.diagnose.causes import CAUSES
+from hunting.diagnose.stats import NoiseModel, Samples, autocovariance, out_of_sample
+from hunting.diagnose.synthetic import bang_bang
+
+MODEL = NominalModel.from_dict({"plant": {"mass": 2.0, "motor_constant": 1.0},
+                                "friction": {"law": "coulomb-viscous", "Fc": 5.0, "b": 20.0}})
+ALPHA = 0.05
+DRAWS = 150
+
+
+def _kin(seed):
+    fs = 1000.0
+    q = bang_bang(fs, 10.0, stroke=0.1, seed=seed, rest=(0.05, 0.3), speed=(0.05, 0.2))
+    t = np.arange(q.size) / fs
+    v = np.gradient(q, 1 / fs)
+    u = MODEL.mass * np.gradient(v, 1 / fs) + MODEL.friction(v)
+    return kinematics(Measurement(t, q, u), 1.0, resolution=0.0)
+
+
+KF, KV = _kin(1), _kin(2)
+SF, SV = Samples.thin(KF.moving, 10), Samples.thin(KV.moving, 10)
+
+
+def _noise(kind, kin, rng):
+    n = kin.t.size
+    w = rng.normal(size=n)
+    if kind == "ar1":
+        x = lfilter([1.0], [1.0, -0.99], w)
+    elif kind == "ar2":                               # a 30 Hz resonance, damping 0.02
+        r, th = 0.98, 2 * np.pi * 30e-3
+        x = lfilter([1.0], [1.0, -2 * r * np.cos(th), r * r], w)
+    else:                                            # level following |a|, coloured
+        x = lfilter([1.0], [1.0, -0.95], w) * (0.3 + np.abs(kin.a) / np.abs(kin.a).max())
+    x = kin.filtered(x)
+    return x / x.std()
+
+
+def _naive(e0, yhat):
+    """Plain least-squares one-sided t test of gamma (independent samples assumed)."""
+    g = float(yhat @ e0) / float(yhat @ yhat)
+    s2 = float(np.sum((e0 - g * yhat) ** 2)) / (e0.size - 1)
+    return float(st.norm.sf(g / np.sqrt(s2 / float(yhat @ yhat))))
+
+
+@pytest.mark.parametrize("kind", ["ar1", "ar2", "hetero"])
+def test_out_of_sample_test_holds_its_level_on_correlated_noise(kind):
+    rng = np.random.default_rng({"ar1": 1, "ar2": 2, "hetero": 3}[kind])
+    names = ("offset", "viscous", "mass", "delay")
+    Xf = {n: CAUSES[n].design(KF, MODEL, CAUSES[n].hypers(KF, MODEL)[0])[SF.idx] for n in names}
+    Xv = {n: CAUSES[n].design(KV, MODEL, CAUSES[n].hypers(KF, MODEL)[0])[SV.idx] for n in names}
+    ours = {n: [] for n in names}
+    naive = []
+    for _ in range(DRAWS):
+        ef, ev = _noise(kind, KF, rng)[SF.idx], _noise(kind, KV, rng)[SV.idx]
+        for n in names:
+            th, *_ = np.linalg.lstsq(Xf[n], ef, rcond=None)          # a "cause" fitted on pure noise
+            yhat = Xv[n] @ th
+            noise = NoiseModel.fit(ev - yhat, SV.run)
+            ours[n].append(out_of_sample(ev, yhat, SV.run, noise)[2])
+            naive.append(_naive(ev, yhat))
+    # three standard errors above the nominal level at this number of draws
+    bound = ALPHA + 3 * np.sqrt(ALPHA * (1 - ALPHA) / DRAWS)
+    rates = {n: float(np.mean(np.array(p) < ALPHA)) for n, p in ours.items()}
+    assert max(rates.values()) <= bound, rates
+    # independent samples assumed: false alarms several times the level (the test can tell)
+    if kind != "ar2":
+        assert np.mean(np.array(naive) < ALPHA) > 2 * bound
+
+
+def test_noise_model_recovers_an_ar2_process_and_skips_gaps():
+    """Yule-Walker inside runs: an AR(2) process cut into runs gives its coefficients back, and a
+    jump between runs (a level change across a gap) does not enter the autocovariance."""
+    rng = np.random.default_rng(5)
+    phi = np.array([1.2, -0.5])
+    e = lfilter([1.0], [1.0, -phi[0], -phi[1]], rng.normal(size=40_000))
+    run = np.repeat(np.arange(40), 1000)
+    e = e + 50.0 * (run % 2)                     # every other run offset by far more than its spread
+    e = e - np.repeat([e[run == r].mean() for r in range(40)], 1000)
+    nm = NoiseModel.fit(e, run)
+    assert nm.order == 2 and np.allclose(nm.phi, phi, atol=0.02)
+    c = autocovariance(e, run, 3)
+    assert c[1] / c[0] == pytest.approx(phi[0] / (1 - phi[1]), abs=0.02)
