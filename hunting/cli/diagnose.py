@@ -22,9 +22,19 @@ Example (the EMPS benchmark, its files from nonlinearbenchmark.org):
 
 
 def add_arguments(p) -> None:
-    from ..diagnose.model import SCHEMA_HELP
     p.formatter_class = argparse.RawDescriptionHelpFormatter
-    p.epilog = DATA_HELP + "\n" + SCHEMA_HELP
+    p.epilog = DATA_HELP
+    format_help = p.format_help
+
+    def with_schema() -> str:
+        # the schema text lives beside its parser in hunting.diagnose.model, whose import loads
+        # the models' numba functions (3 s of compilation on a fresh install, 1 s from the
+        # cache): read it only when this help is shown, not for every command's parser
+        from ..diagnose.model import SCHEMA_HELP
+        p.epilog = DATA_HELP + "\n" + SCHEMA_HELP
+        return format_help()
+
+    p.format_help = with_schema
     p.add_argument("data", help="measured data (CSV, .npz or .mat; columns below)")
     p.add_argument("--model", required=True, help="the nominal model as JSON (format below)")
     p.add_argument("--validate", help="validation data (default: the last 40 %% of DATA)")
