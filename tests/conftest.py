@@ -1,6 +1,11 @@
+import os
 import pathlib
 
-import pytest
+# BLAS threads spin-wait for each other on a loaded machine (tests stalled for minutes in
+# exec_blas_async_wait at load 5); the suite's matrices are small, one thread is as fast.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import pytest  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
