@@ -118,8 +118,14 @@ def load(path, names: dict | None = None) -> Measurement:
         raise SystemDefinitionError(f"data file {path} does not exist")
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        with path.open(newline="") as fh:
-            rows = list(csv.reader(fh))
+        try:
+            with path.open(newline="", encoding="utf-8-sig") as fh:
+                rows = list(csv.reader(fh))
+        except UnicodeDecodeError as exc:
+            raise SystemDefinitionError(f"{path}: not UTF-8 text (byte {exc.start}: {exc.reason}); save it as UTF-8 "
+                                        "CSV, or as .npz/.mat") from None
+        except csv.Error as exc:          # e.g. a NUL byte; the reader names the line
+            raise SystemDefinitionError(f"{path}: not a CSV file ({exc}; in csv's count of lines)") from None
         if len(rows) < 2:
             raise SystemDefinitionError(f"{path}: needs a header row and data rows")
         header = [h.strip() for h in rows[0]]
