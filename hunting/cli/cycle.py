@@ -43,7 +43,7 @@ files = result_files
 
 def run(args, results) -> int:
     from ..continuation import StartOptions, find_cycle
-    from ..plotting import plot_cycle
+    from ..plotting import cycle_panels, plot_cycle
     choice = resolve_system(args)
     names = list(choice.system.state_names)
     x0 = args.x0.vector(names) if args.x0 else None
@@ -55,7 +55,8 @@ def run(args, results) -> int:
     res = find_cycle(choice.source, x0, args.period_guess, choice.params, which=args.which, d_max=args.d_max,
                      start=start)
     if res.success:
-        print(tell(args, res.summary()))
+        states = [name for name, kind, _ in cycle_panels(res, choice.system, choice.model) if kind == "state"]
+        print(tell(args, res.summary(states)))
     if args.json:
         out = res.as_dict()
         out.update(preset=choice.preset, model=getattr(args, "model", None), set=choice.overrides)

@@ -135,14 +135,18 @@ class CycleResult:
                        trivial_error=float(self.trivial_error))
         return out
 
-    def summary(self) -> str:
-        """A few lines for a terminal."""
+    def summary(self, states=None) -> str:
+        """A few lines for a terminal; ``states`` (names) limits the ranges listed, e.g. to a
+        model's mechanical states (the others are counted)."""
         if not self.success:
             return f"{self.label}: no cycle ({self.status.name}): {self.message}"
         lam = ", ".join(f"{abs(z):.4g}" for z in self.multipliers)
+        shown = [k for k in self.state_names if states is None or k in states] or list(self.state_names)
         lines = [f"{self.label}: {'stable' if self.stable else 'unstable'} cycle, period {self.period:.8g}",
                  f"  |multipliers| {lam}  (|lambda_trivial - 1| = {self.trivial_error:.1e})",
-                 "  " + "  ".join(f"{k} in [{self.minimum[k]:.6g}, {self.maximum[k]:.6g}]" for k in self.state_names)]
+                 "  " + "  ".join(f"{k} in [{self.minimum[k]:.6g}, {self.maximum[k]:.6g}]" for k in shown)]
+        if len(shown) < len(self.state_names):
+            lines[-1] += f"  (+ {len(self.state_names) - len(shown)} internal block states)"
         if self.phases:
             several = len({p.contact for p in self.phases}) > 1
             lines.append("  phases: " + ", ".join((f"{p.contact} " if several else "") + f"{p.kind} {p.duration:.6g}"
