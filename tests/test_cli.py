@@ -72,6 +72,7 @@ BAD = [
     ("simulate table9.1 --method euler", "invalid choice: 'euler'"),
     ("simulate table9.1 --set P", "'P' is not NAME=VALUE"),
     ("simulate table9.1 --set =3", "is not NAME=VALUE"),
+    ("simulate table9.1 --set P=20,D=2", "one per option, e.g. --set P=20 --set D=2"),
     ("simulate table9.1 --set P=abc", "--set P=abc: P = 'abc' is not a number"),
     ("simulate table9.1 --set m=-1", "mass = -1.0 is not allowed"),
     ("simulate table9.1 --set Q=1", "'Q' is not a parameter"),

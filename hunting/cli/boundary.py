@@ -107,6 +107,10 @@ def name_value(text: str) -> tuple[str, str]:
     name, sep, value = text.partition("=")
     if not sep or not name.strip() or not value.strip():
         raise argparse.ArgumentTypeError(f"{text!r} is not NAME=VALUE (e.g. P=20)")
+    if "=" in value:
+        pairs = [p.strip() for p in text.replace(";", ",").split(",") if p.strip()]
+        raise argparse.ArgumentTypeError(f"{text!r} holds more than one NAME=VALUE (allowed: one per option, e.g. "
+                                         + " ".join(f"--set {p}" for p in pairs) + ")")
     return name.strip(), value.strip()
 
 
