@@ -1,7 +1,9 @@
 """Pseudo-arclength continuation of periodic orbits in one parameter.
 
 Unknowns u = (x0 without the section component, T, mu), scaled by their magnitudes at the
-start. Predictor: the unit tangent (null vector of [F_z | F_mu], oriented along the previous
+start; the phase plane x[section] = c moves to the orbit's fastest point in x[section] when
+the base point slows below ``reanchor`` of its speed (an orbit drifting off its first plane
+would make a false fold). Predictor: the unit tangent (null vector of [F_z | F_mu], oriented along the previous
 one) with a quadratic term through the point before. Corrector: quasi-Newton on
 [F(u); t . (u - u_pred)] = 0 from the Jacobian extrapolated along the branch, Broyden updates
 and one flow without sensitivities per iteration; the Jacobian (monodromy-based F_z, F_mu from
