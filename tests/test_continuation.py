@@ -190,3 +190,24 @@ def test_radau_jacobians_agree_with_dop853_along_a_lugre_branch():
     assert np.allclose(np.abs(a.multipliers[:n, 1]), np.abs(b.multipliers[:n, 1]), rtol=1e-5)
     with pytest.raises(ValueError, match="jacobian_method"):
         ContinuationOptions(jacobian_method="euler")
+
+
+def test_belt_branch_passes_where_the_orbit_leaves_its_first_phase_plane():
+    """examples/belt.json from k = 2 down to 0.3: the starting orbit's phase plane q = 0.1509
+    stops meeting the orbit near k = 0.436 (the orbit's smallest q rises past it). The branch
+    used to turn there in a false fold (exit 0) and retrace the same stable orbits back to k = 2;
+    the base point now moves along the orbit and the branch reaches 0.3 with the period of the
+    cycle found there on its own."""
+    import json
+    from pathlib import Path
+
+    import hunting
+    from hunting.continuation import follow
+    system = hunting.model(json.loads((Path(__file__).resolve().parents[1] / "examples" / "belt.json").read_text()))
+    br = follow(system, "k", 2.0, 0.3)
+    assert br.status.name == "SUCCESS", br.message
+    assert not [s for s in br.special if s.kind == "fold"]
+    assert np.all(np.diff(br.mu) < 0) and br.mu[-1] == pytest.approx(0.3, rel=1e-9)
+    assert br.stable.all()
+    ref = find_cycle(system, params={"k": 0.3})
+    assert ref.success and br.period[-1] == pytest.approx(ref.period, rel=1e-6)

@@ -1,7 +1,9 @@
 """Pseudo-arclength continuation of periodic orbits in one parameter.
 
 Unknowns u = (x0 without the section component, T, mu), scaled by their magnitudes at the
-start. Predictor: the unit tangent (null vector of [F_z | F_mu], oriented along the previous
+start; the phase plane x[section] = c moves to the orbit's fastest point in x[section] when
+the base point slows below ``reanchor`` of its speed (an orbit drifting off its first plane
+would make a false fold). Predictor: the unit tangent (null vector of [F_z | F_mu], oriented along the previous
 one) with a quadratic term through the point before. Corrector: quasi-Newton on
 [F(u); t . (u - u_pred)] = 0 from the Jacobian extrapolated along the branch, Broyden updates
 and one flow without sensitivities per iteration; the Jacobian (monodromy-based F_z, F_mu from
@@ -23,6 +25,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import SystemDefinitionError
+from ..integrate.simulate import simulate
 from ..results import SpecialPoint
 from ..system import PiecewiseSystem
 from .flow import Flow, flow
@@ -56,7 +59,12 @@ class ContinuationOptions:
     check_events : for systems with stick modes, each point's period is sampled (2001 points)
     and checked for a stick guard on its firing side (:func:`missed_event`: a flow stepped over
     a short break-away, and the point is not an orbit of the system); from such a point on the
-    flows take at most T / STEPS_PER_PERIOD per step and the point is corrected again."""
+    flows take at most T / STEPS_PER_PERIOD per step and the point is corrected again.
+    reanchor : the phase condition x[section] = c is a fixed plane; an orbit that drifts with
+    the parameter can leave it (its extreme of x[section] passes c) and the branch would turn
+    there in a false fold. When the speed |x[section]'| at the base point falls below this
+    fraction of its largest value along the orbit, the base point moves to where that speed
+    is largest (same orbit, new c); 0 turns this off."""
 
     ds: float = 0.05
     ds_min: float = 1e-6
@@ -76,8 +84,11 @@ class ContinuationOptions:
     quadratic_predictor: bool = True
     max_step: float = np.inf
     check_events: bool = True
+    reanchor: float = 0.3
 
     def __post_init__(self):
+        if not (np.isfinite(self.reanchor) and 0 <= self.reanchor < 1):
+            raise SystemDefinitionError(f"reanchor = {self.reanchor!r} is not allowed: it must be in [0, 1)")
         for name in ("ds", "ds_min", "ds_max", "newton_tol", "dmu", "fold_tol", "jacobian_reuse", "trivial_tol"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
@@ -393,7 +404,58 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
     t = tangent(J)
     if np.sign(t[-1]) != np.sign(mu_end - mu0):
         t = -t
+
+    def section_speeds(x, T, mu):
+        """(samples (m, n), |x[section]'| (m,)) along one period from x, or None."""
+        sys_ = system_at(mu)
+        tr = simulate(sys_, x, (0.0, T), t_eval=np.linspace(0.0, T, 2001), rtol=kw_res["rtol"],
+                      atol=kw_res["atol"], max_step=kw_res["max_step"], max_events=sopt.max_events)
+        if not tr.success or len(tr.t) < 2:
+            return None
+        speed = np.array([abs(sys_.evaluate(xi, int(mi))[section]) for xi, mi in zip(tr.x, tr.mode)])
+        return tr.x, speed
+
+    def reanchor(v, t, fl, force=False):
+        """Move the base point of the orbit at v to where |x[section]'| is largest (the phase
+        plane x[section] = c_sec follows the orbit) unless its speed there is still at least
+        ``reanchor`` of that largest one (then it only becomes the new ``ref_speed``) and not
+        ``force``. Returns (v, t, fl, J) in the new coordinates, or None where the point stays
+        (its plane is still transversal, or the moved point does not converge)."""
+        nonlocal c_sec, ref_speed
+        x, T, mu = unpack(v)
+        out = section_speeds(x, T, mu)
+        if out is None:
+            return None
+        xs, speed = out
+        i = int(np.argmax(speed))
+        if not force and abs(fl.f[section]) >= opt.reanchor * speed[i]:
+            ref_speed = abs(float(fl.f[section]))
+            return None
+        old = c_sec, scale.copy()
+        x_new = xs[i].copy()
+        c_sec = float(x_new[section])
+        scale[:-2] = np.maximum(np.abs(x_new[free]), 1e-3 * np.max(np.abs(x_new)))
+        e_mu = np.zeros_like(v)
+        e_mu[-1] = 1.0
+        res = correct(np.concatenate([x_new[free], [T, mu]]) / scale, e_mu, None, reuse=False)
+        if res is None or abs(unpack(res[0])[2] - mu) > 1e-9 * max(abs(mu), 1e-12):
+            c_sec, scale[:] = old[0], old[1]
+            return None
+        v_new, J_new, fl_new, _ = res
+        t_new = tangent(J_new)
+        # T and mu keep their scales: their tangent components orient the new tangent
+        if np.dot(t_new[-2:], t[-2:]) < 0:
+            t_new = -t_new
+        ref_speed = abs(float(fl_new.f[section]))
+        return v_new, t_new, fl_new, J_new
+
+    # |x[section]'| at the base point when it was last judged transversal: the start's own
+    # plane is kept (the cycle search chose it) until the speed falls below reanchor of this
+    ref_speed = abs(float(fl.f[section]))
     pts_v, pts_fl = [v], [fl]
+    pts_xtm = [unpack(v)]
+    v_before = None                     # the point before v in the current coordinates
+    forced_at = -1                      # the point from which the base point was last moved at a turn
     J_prev = None
     special: list[SpecialPoint] = []
     ds = opt.ds
@@ -405,10 +467,10 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
                                                         f"{unpack(v)[2]:.6g}: raise max_points or ds_max")
             break
         v_pred = v + ds * t
-        if len(pts_v) >= 2 and opt.quadratic_predictor:
+        if v_before is not None and opt.quadratic_predictor:
             # second-order predictor: the parabola through the last point with its tangent and
             # the point before it (halves the corrector's work on curved branches)
-            chord = pts_v[-2] - v
+            chord = v_before - v
             h = float(np.linalg.norm(chord))
             if h > 0:
                 c = (chord + h * t) / h ** 2
@@ -419,7 +481,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
             # the Jacobian extrapolated along the branch like the point: its error at the
             # predictor is O(ds^2) instead of O(ds), so the quasi-Newton corrector rarely
             # needs to recompute it
-            J_pred = J + (J - J_prev) * (ds / float(np.linalg.norm(v - pts_v[-2])))
+            J_pred = J + (J - J_prev) * (ds / float(np.linalg.norm(v - v_before)))
         res = correct(v_pred, t, J_pred)
         if res is not None and missed(res[0]):
             # the point is not an orbit of the system: correct it again with bounded steps
@@ -459,8 +521,18 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         # predictor was too far) and the tangent's turn (no more than half of max_angle)
         turn = float(np.arccos(np.clip(np.dot(t_new, t), -1.0, 1.0)))
         grow = min((1.4, 1.0, 0.7)[min(refreshes, 2)], 0.5 * opt.max_angle / max(turn, 1e-12))
-        # fold: the parameter component of the tangent changes sign
+        # fold: the parameter component of the tangent changes sign; not where the orbit only
+        # slid off the phase plane (the section tangent to it: the branch retraces the same
+        # orbits), there the base point moves and the step is taken again
         if np.sign(t_new[-1]) != np.sign(t[-1]):
+            if (opt.reanchor > 0 and forced_at != len(pts_v)
+                    and min(abs(fl.f[section]), abs(fl_new.f[section])) < opt.reanchor * ref_speed):
+                forced_at = len(pts_v)              # once per point: a real fold is reported next time
+                moved = reanchor(v, t, fl, force=True)
+                if moved is not None:
+                    v, t, fl, J = moved
+                    J_prev = v_before = None
+                    continue
             sp = _refine_fold(lambda vp, tp: correct(vp, tp, J, reuse=False), tangent, unpack, v, t, ds, opt, len(pts_v) - 1)
             special.append(sp)
             turns += 1
@@ -472,9 +544,16 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
                                         {"events_before": len(sig_old), "events_after": len(sig_new),
                                          "modes_before": [names[m] for m in sig_old],
                                          "modes_after": [names[m] for m in sig_new]}))
+        v_before = v
         v, t, fl, J, J_prev = v_new, t_new, fl_new, J_new, J
         pts_v.append(v)
         pts_fl.append(fl)
+        pts_xtm.append(unpack(v))
+        if opt.reanchor > 0 and ref_speed > 0 and abs(fl.f[section]) < opt.reanchor * ref_speed:
+            moved = reanchor(v, t, fl)
+            if moved is not None:
+                v, t, fl, J = moved
+                J_prev = v_before = None
         if mu_new <= lo or mu_new >= hi:
             break
         if turns >= max_turns and stop_at_mu is not None:
@@ -484,8 +563,7 @@ def continue_orbit(system_at: Callable[[float], PiecewiseSystem], orbit: Periodi
         ds = float(np.clip(ds * grow, max(opt.ds_min, 0.5 * ds), opt.ds_max))
     # assemble
     mus, Ts, amps, lams, stab, xs, modes = [], [], [], [], [], [], []
-    for vv, ff in zip(pts_v, pts_fl):
-        x, T, mu = unpack(vv)
+    for (x, T, mu), ff in zip(pts_xtm, pts_fl):
         lam, _ = floquet(ff.Phi, ff.f)
         mus.append(mu)
         Ts.append(T)
