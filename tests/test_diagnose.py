@@ -365,3 +365,25 @@ def test_wrong_stribeck_level_is_found_and_the_event_map_follows(tmp_path):
     assert (tmp_path / "event_map.png").is_file() and "event_map.png" in html.read_text()
     saved = json.loads((tmp_path / "diagnosis.json").read_text())
     assert len(saved["behaviour"]["measured"]["event_map"]) == len(b["measured"]["event_map"]) >= 20
+
+
+def test_floor_reason_claims_numerical_precision_only_for_a_residual_at_that_level():
+    """Review (newcomer): a cause rejected by the absolute floor with a 491 mN validation residual
+    was said to leave a model that 'already reproduces the data to numerical precision'."""
+    from hunting.diagnose.force import _why
+    large = dict(p_value=0.0, gain=0.013, rms=0.491, rms_without=0.49122, floor=0.0005)
+    text = _why(large, 1e-3, 0.05)
+    assert "numerical precision" not in text and "below that floor" in text and "0.491 N" in text
+    tiny = dict(p_value=0.0, gain=0.013, rms=2e-4, rms_without=2.2e-4, floor=0.0005)
+    assert "numerical precision" in _why(tiny, 1e-3, 0.05)
+
+
+def test_no_cause_headline_gives_the_residual_not_a_model_that_explains_the_data():
+    """A 3 N offset with only cogging searched: no cause passes, and the report says that no
+    cause passed the rule with the residual's size, not that the nominal model explains the data."""
+    dg = _run(replace(TruePlant(), offset=-3.0), causes=["cogging"])
+    assert dg.causes == [] and dg.nominal > 2.0
+    text = format_terminal(dg)
+    first = text.splitlines()[0]
+    assert "explains the data" not in text and "no cause passed the rule" in first, first
+    assert " N RMS" in first and "of the drive force" in first
