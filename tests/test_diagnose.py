@@ -387,3 +387,25 @@ def test_no_cause_headline_gives_the_residual_not_a_model_that_explains_the_data
     first = text.splitlines()[0]
     assert "explains the data" not in text and "no cause passed the rule" in first, first
     assert " N RMS" in first and "of the drive force" in first
+
+
+def test_validating_on_the_fitting_data_is_warned_and_noted(tmp_path, capsys):
+    """Review (newcomer): --validate given the fitting file (or a copy) ran the 'out-of-sample'
+    test on the fitting data without a word. Now one warning line on stderr before the work, the
+    same note in the report and the JSON; the results are still computed."""
+    from hunting.cli import main
+    save_csv(generate(TruePlant(), 6.0, seed=1), tmp_path / "fit.csv")
+    (tmp_path / "copy.csv").write_bytes((tmp_path / "fit.csv").read_bytes())
+    (tmp_path / "model.json").write_text(json.dumps(NOMINAL))
+    rc = main(["diagnose", str(tmp_path / "fit.csv"), "--model", str(tmp_path / "model.json"), "--validate",
+               str(tmp_path / "copy.csv"), "--json", str(tmp_path / "out.json")])
+    assert rc == 0
+    cap = capsys.readouterr()
+    warn = [line for line in cap.err.splitlines() if "not out of sample" in line]
+    assert len(warn) == 1 and warn[0].startswith("warning:") and "copy.csv" in warn[0]
+    assert "not out of sample" in cap.out and "Rule:" in cap.out
+    notes = json.loads((tmp_path / "out.json").read_text())["notes"]
+    assert any("not out of sample" in n for n in notes)
+    # separate records: no such note
+    dg = _run(TruePlant(), duration=6.0)
+    assert not any("not out of sample" in n for n in dg.notes)

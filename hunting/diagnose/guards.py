@@ -57,6 +57,16 @@ def check_inputs(fit: Measurement, validate: Measurement, model: NominalModel) -
     return notes
 
 
+SAME_DATA_NOTE = ("the validation data are the fitting data ({}): the out-of-sample test then runs on the fitting data "
+                  "and is not out of sample; give a separate record with --validate (or none: the last 40 % of DATA)")
+
+
+def same_record(a: Measurement, b: Measurement) -> bool:
+    """Whether two measurements hold the same samples (q and u equal, whatever their names or
+    time origins): validation on them would not be out of sample."""
+    return a.n == b.n and np.array_equal(a.q, b.q) and np.array_equal(a.u, b.u)
+
+
 def check_units(kin, model: NominalModel, name: str) -> None:
     """An error when the model's inertia force m a or friction force F(v) on the sliding samples
     is more than MAX_FORCE_RATIO times the measured drive force: the data and the model then

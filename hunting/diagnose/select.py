@@ -170,7 +170,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .force import Library, select
-    from .guards import check_inputs, check_units
+    from .guards import SAME_DATA_NOTE, check_inputs, check_units, same_record
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -178,6 +178,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     tick = _Progress(progress, 2 + sum(getattr(CAUSES[n], "CHANNEL", "force") != "force" for n in names))
     if not (isinstance(max_causes, (int, np.integer)) and 1 <= max_causes <= 4):
         raise SystemDefinitionError(f"max_causes = {max_causes!r} must be an integer in [1, 4]")
+    same = validate is not None and same_record(fit, validate)
     if validate is None:
         if fit.n < 250:
             raise SystemDefinitionError(f"{fit.name}: {fit.n} samples are too few to split into fitting and validation "
@@ -185,6 +186,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         t_split = fit.t[0] + 0.6 * (fit.t[-1] - fit.t[0])
         fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
     notes: list = list(check_inputs(fit, validate, model))
+    if same:
+        notes.append(SAME_DATA_NOTE.format(validate.name))
     if window is None:
         window = default_window(fit, validate, model)
     sensor = dict(resolution=model.resolution, noise=model.sensor_noise)
