@@ -409,3 +409,22 @@ def test_validating_on_the_fitting_data_is_warned_and_noted(tmp_path, capsys):
     # separate records: no such note
     dg = _run(TruePlant(), duration=6.0)
     assert not any("not out of sample" in n for n in dg.notes)
+
+
+def test_sentences_quote_no_model_value_the_nominal_law_lacks():
+    """Review (newcomer): a Coulomb + viscous model was said to have a Stribeck velocity
+    '(model 1 m/s)' (its internal placeholder); a model without viscous friction gave 'inf times'
+    and 'inf %'; a model without offset 'has 0 N'."""
+    from hunting.diagnose.causes import CAUSES
+    cv = NominalModel.from_dict(NOMINAL)
+    s = CAUSES["stribeck"].sentence({"Fc": 19.0, "Fs": 30.0, "vs": 0.234}, {}, cv)
+    assert "no Stribeck dip" in s and "1 m/s" not in s and "model 20 N" not in s.split("Fc")[0], s
+    assert "234 mm/s" in s
+    dipped = true_model(replace(TruePlant(), Fs=30.0, vs=0.01))
+    assert "(model 10 mm/s)" in CAUSES["stribeck"].sentence({"Fc": 19.0, "Fs": 30.0, "vs": 0.234}, {}, dipped)
+    coulomb = NominalModel.from_dict({"plant": NOMINAL["plant"], "friction": {"law": "coulomb-viscous", "Fc": 20.0}})
+    for name, p in (("viscous", {"b": 200.0}), ("asymmetry", {"b_pos": 190.0, "b_neg": 210.0})):
+        s = CAUSES[name].sentence(p, {}, coulomb)
+        assert "inf" not in s and "has none" in s, s
+    s = CAUSES["offset"].sentence({"offset": -3.0}, {}, cv)
+    assert "the model has none" in s and "0 N" not in s, s
