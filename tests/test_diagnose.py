@@ -428,3 +428,17 @@ def test_sentences_quote_no_model_value_the_nominal_law_lacks():
         assert "inf" not in s and "has none" in s, s
     s = CAUSES["offset"].sentence({"offset": -3.0}, {}, cv)
     assert "the model has none" in s and "0 N" not in s, s
+
+
+def test_counts_in_reasons_agree_with_their_number():
+    """Review (newcomer): 'the controller output does not pile up at a bound (1 samples at its
+    extreme)'."""
+    from hunting.diagnose.causes import CAUSES
+    from hunting.diagnose.causes._words import _count
+    t = np.arange(400) * 1e-3
+    u = 0.5 * np.sin(2 * np.pi * 3.3 * t)
+    u[123] = 2.0
+    meas = Measurement(t, np.zeros_like(t), u)
+    reason = CAUSES["saturation"].judge(meas, meas, None, None, NominalModel.from_dict(NOMINAL), False, 1e-6)["reason"]
+    assert "(1 sample at its extreme)" in reason, reason
+    assert (_count(0, "rest"), _count(1, "rest"), _count(2, "rest")) == ("0 rests", "1 rest", "2 rests")
