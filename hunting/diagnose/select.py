@@ -170,7 +170,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .force import Library, select
-    from .guards import SAME_DATA_NOTE, check_inputs, check_units, same_record
+    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_units, same_record
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -188,6 +188,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     notes: list = list(check_inputs(fit, validate, model))
     if same:
         notes.append(SAME_DATA_NOTE.format(validate.name))
+    notes += [n for n in (check_controller(m, model) for m in ((fit,) if same else (fit, validate))) if n]
     if window is None:
         window = default_window(fit, validate, model)
     sensor = dict(resolution=model.resolution, noise=model.sensor_noise)
