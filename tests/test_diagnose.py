@@ -460,3 +460,33 @@ def test_a_controller_that_does_not_give_the_measured_u_is_noted():
     dg = _run(true, nominal=wrong, duration=6.0)
     notes = [n for n in dg.notes if "RMS mismatch to the measured u" in n]
     assert len(notes) == 2 and "50%" in notes[0] and "kv" in notes[0], dg.notes
+
+
+def test_a_worse_extended_resimulation_is_noted():
+    """Review (newcomer): 're-simulated position RMS error 126 µm -> 149 µm' stood in the table
+    without a word. A worse extended re-simulation gets a note with both numbers; a better one
+    none."""
+    from hunting.diagnose.select import worse_resimulation
+    view = {"nominal": {"position_rms": 126e-6, "force_rms": 4.5}, "extended": {"position_rms": 149e-6, "force_rms": 2.5}}
+    notes = worse_resimulation(view)
+    assert len(notes) == 1 and "126 µm -> 149 µm" in notes[0] and "+18%" in notes[0] and "worse" in notes[0], notes
+    view["extended"]["position_rms"] = 100e-6
+    assert worse_resimulation(view) == []
+
+
+def test_the_worse_resimulation_note_reaches_the_report(monkeypatch):
+    """The note is in the diagnosis (and its report) when a cause was selected and the behaviour
+    view's extended errors are larger (the view's errors swapped to make them so)."""
+    import hunting.diagnose.behaviour as behaviour
+    compare = behaviour.compare
+
+    def swapped(*args, **kw):
+        view = compare(*args, **kw)
+        return dict(view, nominal=view["extended"], extended=view["nominal"])
+    monkeypatch.setattr(behaviour, "compare", swapped)
+    true = replace(TruePlant(), offset=-3.0)
+    nominal = true_model(true).replace(offset=0.0)
+    dg = _run(true, nominal=nominal, duration=6.0, behaviour=True, causes=["offset"])
+    assert [c.name for c in dg.causes] == ["offset"]
+    assert any("re-simulates the validation run worse" in n for n in dg.notes), dg.notes
+    assert "re-simulates the validation run worse" in format_terminal(dg)

@@ -264,12 +264,29 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         res = model.resolution if model.resolution is not None else resolution_of(validate.q)
         sims = {"nominal": resimulate(validate, model), "extended": resimulate(validate, ext)}
         view = compare(validate, sims, model.cm, res)
+        if result:
+            notes += worse_resimulation(view)
     elif behaviour:
         notes.append("behaviour view skipped: it needs the model's 'controller' and the reference q_ref in the data")
     tick("done")
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
                      fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
                      fc["explanations"])
+
+
+def worse_resimulation(view: dict) -> list:
+    """Notes (list of str) for the behaviour view's re-simulation errors that the extended model
+    makes larger than the nominal one: the causes were selected on their own channels' metrics,
+    and a re-simulation they worsen must be said, not left in the table."""
+    from .causes._words import _q
+    out = []
+    for key, label, unit in (("position_rms", "position", "m"), ("force_rms", "drive force", "N")):
+        a, b = view["nominal"].get(key), view["extended"].get(key)
+        if a is not None and b is not None and np.isfinite(a) and b > a:
+            out.append(f"the extended model re-simulates the validation run worse than the nominal one: {label} RMS "
+                       f"error {_q(a, None, unit)} -> {_q(b, None, unit)} (+{(b / a - 1) if a > 0 else np.inf:.0%}); its "
+                       "causes were selected on the force residual and their own metrics, not on the re-simulation")
+    return out
 
 
 WINDOW_CYCLES = 0.5      # the smoothing window, in periods of the loop's bandwidth (at least 31 samples)
