@@ -266,7 +266,7 @@ def test_short_record_lists_what_it_cannot_test():
     silent empty report."""
     dg = _run(TruePlant(offset=-3.0), duration=2.5)
     untested = {u["name"]: u["reason"] for u in dg.untested}
-    assert "dwell" in untested and "rests" in untested["dwell"]
+    assert "dwell" in untested and "rest ending in motion" in untested["dwell"]
     assert "Not tested on these data" in format_terminal(dg)
 
 
