@@ -404,3 +404,17 @@ def test_pgf_without_tex_is_refused_before_computing(monkeypatch, capsys, tmp_pa
     code, _, err = run_main(capsys, ["simulate", "table9.1", "--plot", str(tmp_path / "f.pgf")])
     line = one_line_error(err)
     assert code == 2 and "writing .pgf needs the TeX program 'xelatex'" in line and ".png" in line
+
+
+def test_diagnose_help_says_everything_the_controller_is_used_for(capsys):
+    """Review (newcomer): the help said the controller was needed only for the behaviour view
+    and the saturation/quantization/presliding causes; the noise-fed causes are also checked
+    along the nominal loop's noise-free re-simulation, which runs the controller."""
+    from hunting.diagnose.causes import CAUSES
+    assert main(["diagnose", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "Needed for the behaviour view and for the saturation" not in text
+    assert "noise-free re-simulation" in text and "gives the measured u" in text
+    fed = [n for n, mod in CAUSES.items() if getattr(mod, "NOISE_FED", False)]
+    at = text.index("noise-fed causes")
+    assert fed and all(n in text[at:at + 200] for n in fed), fed

@@ -71,6 +71,10 @@ def run(args, results) -> int:
     model = NominalModel.from_json(args.model)
     fit = load(args.data, names)
     val = load(args.validate, names) if args.validate else None
+    if val is not None:
+        from ..diagnose.guards import SAME_DATA_NOTE, same_record
+        if same_record(fit, val):
+            print(f"warning: {SAME_DATA_NOTE.format(args.validate)}", file=sys.stderr)
     bar = tqdm(total=1, desc="diagnose", file=sys.stderr, disable=not sys.stderr.isatty(), leave=False,
                bar_format="{desc}: {n}/{total} {bar} {elapsed}")
 

@@ -36,6 +36,7 @@ from .model import NominalModel
 from .stats import NoiseModel, Samples, gls, out_of_sample
 
 PRECISION = 1e-4      # a cause must remove more than this fraction of the drive force's RMS
+PRECISION_WORDS = 10.0   # reports call a residual "numerical precision" up to this many floors (words only)
 
 
 @dataclass
@@ -363,10 +364,22 @@ def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) 
     if t["gain"] < min_gain:
         out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
     if 0.0 <= t["rms_without"] - t["rms"] <= t["floor"]:     # a cause that makes it worse has its reason above
-        out.append(f"it removes {t['rms_without'] - t['rms']:.2g} N RMS of the validation residual, not more than "
-                   f"{PRECISION:g} of the drive force's RMS ({t['floor']:.2g} N): the model already reproduces the "
-                   "data to numerical precision")
+        removed = (f"it removes {t['rms_without'] - t['rms']:.2g} N RMS of the validation residual, not more than "
+                   f"{PRECISION:g} of the drive force's RMS ({t['floor']:.2g} N)")
+        if at_precision(t["rms"], t["floor"]):
+            out.append(removed + f": the model already reproduces the data to numerical precision (residual "
+                                 f"{t['rms']:.2g} N RMS)")
+        else:
+            out.append(removed + f": the improvement is below that floor (the validation residual is "
+                                 f"{t['rms']:.3g} N RMS)")
     return " and ".join(out)
+
+
+def at_precision(rms: float, floor: float) -> bool:
+    """Whether a residual of ``rms`` [N] is at the level of numerical precision: at most
+    ``PRECISION_WORDS`` times the floor (``PRECISION`` of the drive force's RMS). Wording only:
+    the rule uses the floor itself."""
+    return rms <= PRECISION_WORDS * floor
 
 
 def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: float = 0.25):

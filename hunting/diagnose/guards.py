@@ -57,6 +57,41 @@ def check_inputs(fit: Measurement, validate: Measurement, model: NominalModel) -
     return notes
 
 
+CONTROLLER_MISMATCH = 0.10   # the controller's u against the measured u, relative RMS, before a note
+
+
+def check_controller(meas: Measurement, model: NominalModel) -> str | None:
+    """A note when the model's controller, fed the measured q and q_ref, does not give the
+    measured u: RMS mismatch above CONTROLLER_MISMATCH of u's RMS (None when it does, or
+    without a controller, a reference or a u that moves). Re-simulations with a controller that
+    is not the machine's judge the model on a loop that was never run."""
+    if model.controller is None or meas.q_ref is None:
+        return None
+    from .resimulate import controller_output
+    u_model = controller_output(meas, model.controller)
+    size = float(np.sqrt(np.mean(meas.u ** 2)))
+    if size <= 0 or not np.all(np.isfinite(u_model)):
+        return None
+    mismatch = float(np.sqrt(np.mean((u_model - meas.u) ** 2))) / size
+    if mismatch <= CONTROLLER_MISMATCH:
+        return None
+    keys = "kp/kv/sample_time" if model.controller.get("type") == "pd-velocity-loop" else \
+        "kp/kd/ki/derivative_on/tau_f/sample_time"
+    return (f"{meas.name}: the model's controller fed the measured q and q_ref gives u with {mismatch:.0%} RMS "
+            f"mismatch to the measured u (more than {CONTROLLER_MISMATCH:.0%}): check the controller's {keys} and "
+            "the sign and unit of u; re-simulations run a loop the machine did not")
+
+
+SAME_DATA_NOTE = ("the validation data are the fitting data ({}): the out-of-sample test then runs on the fitting data "
+                  "and is not out of sample; give a separate record with --validate (or none: the last 40 % of DATA)")
+
+
+def same_record(a: Measurement, b: Measurement) -> bool:
+    """Whether two measurements hold the same samples (q and u equal, whatever their names or
+    time origins): validation on them would not be out of sample."""
+    return a.n == b.n and np.array_equal(a.q, b.q) and np.array_equal(a.u, b.u)
+
+
 def check_units(kin, model: NominalModel, name: str) -> None:
     """An error when the model's inertia force m a or friction force F(v) on the sliding samples
     is more than MAX_FORCE_RATIO times the measured drive force: the data and the model then

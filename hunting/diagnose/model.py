@@ -46,8 +46,13 @@ errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(
                 "form": "K" with "K"), optional "derivative_on": "error" | "measurement",
                 "tau_f" [s], "sample_time" [s], "saturation", "output_resolution";
                 or {"type": "pd-velocity-loop", "kp" [1/s], "kv", "sample_time", "saturation"}
-                (u = kv (kp (q_ref - q) - v)). Needed for the behaviour view and for the
-                saturation, quantization and presliding causes.
+                (u = kv (kp (q_ref - q) - v)). Used, with q_ref in the data, by the
+                behaviour view and the saturation, quantization and presliding causes (which
+                re-simulate the loop), by the noise-fed causes (viscous, asymmetry, mass,
+                delay, flexibility, lag), checked along the nominal loop's noise-free
+                re-simulation from q_ref (without a controller: along q_ref itself with the
+                model's inverse dynamics), and by a check that it gives the measured u from
+                the measured q (a note above 10 % RMS mismatch).
   "sensor":     {"resolution": m, "noise": m}  (encoder step; noise before quantization)
   or a preset:  {"preset": "table9.1", "set": {"P": 60.0}}  (see: hunting models)
 

@@ -69,9 +69,7 @@ def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
                             f"without it -> {_metric_value(g['metric'], g['extended'])} with it ({_pct(rel)} lower)",
                             "     ", "       "))
     else:
-        what = ("no cause found: the nominal model explains the data within the rule"
-                if dg.nominal is not None or dg.behaviour else "no cause could be tested on these data")
-        out.append(what + ".")
+        out.append(no_cause_headline(dg) + ".")
     rows = []
     for g in dg.gains():
         label = g["metric"] if "measured" not in g else (
@@ -115,6 +113,25 @@ def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
     out.append("")
     out.append(wrap(f"Rule: {dg.criterion}.", "", "  "))
     return "\n".join(out)
+
+
+def no_cause_headline(dg: Diagnosis) -> str:
+    """The report's first line when no cause was found: that no cause passed the rule, with the
+    size of the nominal model's validation force residual (against the drive force's RMS). Only a
+    residual at numerical precision (:func:`hunting.diagnose.force.at_precision`) is called
+    reproduced: a large residual that no cause explains is not a model that explains the data."""
+    from .force import PRECISION, at_precision
+    if dg.nominal is None:
+        return ("no cause found: no cause passed the rule (the force channel was not run)" if dg.behaviour
+                else "no cause could be tested on these data")
+    kv = dg.kin_val
+    drive = float(np.sqrt(np.mean(kv.force[kv.moving] ** 2))) if kv.moving.any() else 0.0
+    if drive > 0 and at_precision(dg.nominal, PRECISION * drive):
+        return (f"no cause found: the nominal model reproduces the validation data to numerical precision (force "
+                f"residual {_q(dg.nominal, None, 'N')} RMS)")
+    size = f"{_q(dg.nominal, None, 'N')} RMS" + (f", {_pct(dg.nominal / drive)} of the drive force's RMS"
+                                                 if drive > 0 else "")
+    return f"no cause found: no cause passed the rule; the nominal model's validation force residual is {size}"
 
 
 def _reason(r: dict) -> str:
@@ -262,7 +279,7 @@ def write_report(dg: Diagnosis, directory) -> Path:
 <p>Rule: {html.escape(dg.criterion)}.</p>
 <table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
 <th>validation metric: nominal → extended</th></tr>{rows}</table>
-{'<ul>' + finds + '</ul>' if finds else '<p>No cause found: the nominal model explains the data within the rule.</p>'}
+{'<ul>' + finds + '</ul>' if finds else '<p>' + html.escape(no_cause_headline(dg).capitalize()) + '.</p>'}
 {'<h2>Alternatives</h2><ul>' + alt + '</ul>' if alt else ''}
 {'<h2>Tested and rejected (why)</h2><ul>' + rej + '</ul>' if rej else ''}
 {'<h2>Not tested on these data (why)</h2><ul>' + unt + '</ul>' if unt else ''}

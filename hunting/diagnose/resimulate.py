@@ -115,6 +115,51 @@ class SampledController:
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _control(ctrl, x, y, rk, T):
+    """One controller update from the measured position y [m] and the reference rk [m], T [s]
+    after the last: the output before injection, saturation and DAC; updates the controller
+    state x[4:9] = [I, D, x_prev, y_prev, qf_prev] in place."""
+    if ctrl[0] == 1.0:
+        e = y - rk
+        sig = y if ctrl[6] > 0.5 else e
+        x[4] += T * e
+        x[5] = (ctrl[5] * x[5] + (sig - x[6])) / (ctrl[5] + T)
+        x[6] = sig
+        uc = -(ctrl[1] * e + ctrl[2] * x[5] + ctrl[3] * x[4])
+    else:
+        qf = 0.5 * y + 0.5 * x[7]
+        uc = ctrl[4] * (ctrl[1] * (rk - y) - (qf - x[8]) / T)
+        x[8] = qf
+    x[7] = y
+    return uc
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _output(ctrl, u):
+    """The controller output u after its saturation and the DAC's step."""
+    if u > ctrl[7]:
+        u = ctrl[7]
+    elif u < -ctrl[7]:
+        u = -ctrl[7]
+    if ctrl[9] > 0.0:                  # the DAC's step
+        u = ctrl[9] * math.floor(u / ctrl[9] + 0.5)
+    return u
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _replay(ctrl, r, y, inj, x, dt, u_out):
+    """The controller's outputs u_out (n,) on measured positions y (n,) [m] and references r
+    (n,) [m] sampled every dt [s], with the injection inj (n,) added, from the controller state x
+    (as in _loop)."""
+    hold = int(ctrl[8])
+    uc = 0.0
+    for k in range(y.size):
+        if k % hold == 0:
+            uc = _control(ctrl, x, y[k], r[k], dt * hold)
+        u_out[k] = _output(ctrl, uc + inj[k])
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _cog(q, cog, bases):
     out = 0.0
     for b in bases:
@@ -167,26 +212,8 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
         qm = q + noise[k]
         y = resolution * math.floor(qm / resolution + 0.5) if resolution > 0.0 else qm
         if k % hold == 0:
-            T = dt * hold
-            if ctrl[0] == 1.0:
-                e = y - r[k]
-                sig = y if ctrl[6] > 0.5 else e
-                x[4] += T * e
-                x[5] = (ctrl[5] * x[5] + (sig - x[6])) / (ctrl[5] + T)
-                x[6] = sig
-                uc = -(ctrl[1] * e + ctrl[2] * x[5] + ctrl[3] * x[4])
-            else:
-                qf = 0.5 * y + 0.5 * x[7]
-                uc = ctrl[4] * (ctrl[1] * (r[k] - y) - (qf - x[8]) / T)
-                x[8] = qf
-            x[7] = y
-        u = uc + inj[k]
-        if u > ctrl[7]:
-            u = ctrl[7]
-        elif u < -ctrl[7]:
-            u = -ctrl[7]
-        if ctrl[9] > 0.0:                  # the DAC's step
-            u = ctrl[9] * math.floor(u / ctrl[9] + 0.5)
+            uc = _control(ctrl, x, y, r[k], dt * hold)
+        u = _output(ctrl, uc + inj[k])
         q_out[k] = y
         u_out[k] = u
         v_out[k] = v
@@ -331,12 +358,8 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
     at_rest = abs(v0) * dt <= max(res, 1e-12)
     inj = np.zeros(meas.n) if meas.u_inj is None else np.ascontiguousarray(meas.u_inj)
     u0 = float(meas.u[0])
-    e0 = q0 - float(meas.q_ref[0])
     c = ctrl.array(dt)
-    # controller state so that its first output is the measured u[0] (the integral carries the
-    # force the loop needed before the record started)
-    I0 = -(u0 - inj[0] + c[1] * e0) / c[3] - c[8] * dt * e0 if (ctrl.kind == "pid" and c[3] != 0.0) else 0.0
-    sig0 = q0 if ctrl.derivative_on_measurement else e0
+    I0, sig0 = _controller_start(ctrl, c, meas, inj)
     z0 = 0.0
     if model.law == "lugre":
         # the bristles carry the force that holds the mass at the start (quasi-static)
@@ -369,6 +392,33 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
                          f"(now {substeps}) or check the model's parameters")
     m = n if ok else done
     return Simulation(meas.t[:m], qo[:m], uo[:m], vo[:m], so[:m], ok, msg)
+
+
+def _controller_start(ctrl: SampledController, c: np.ndarray, meas: Measurement, inj: np.ndarray) -> tuple:
+    """(integral, derivative signal) of the controller state at the first sample, so that its
+    first output is the measured u[0] (the integral carries the force the loop needed before the
+    record started)."""
+    q0, e0 = float(meas.q[0]), float(meas.q[0] - meas.q_ref[0])
+    I0 = (-(float(meas.u[0]) - inj[0] + c[1] * e0) / c[3] - c[8] * meas.dt * e0
+          if (ctrl.kind == "pid" and c[3] != 0.0) else 0.0)
+    return I0, (q0 if ctrl.derivative_on_measurement else e0)
+
+
+def controller_output(meas: Measurement, controller: dict) -> np.ndarray:
+    """The output u (n,) of the ``controller`` (the MODEL.json schema) fed the measured q and
+    q_ref of ``meas`` (its injection u_inj added, saturation and DAC step applied), from the state
+    whose first output is the measured u[0]: what the model's controller would have sent."""
+    if meas.q_ref is None:
+        raise SystemDefinitionError(f"{meas.name}: the controller's output needs the reference column q_ref")
+    ctrl = SampledController.from_schema(controller)
+    c = ctrl.array(meas.dt)
+    inj = np.zeros(meas.n) if meas.u_inj is None else np.ascontiguousarray(meas.u_inj)
+    I0, sig0 = _controller_start(ctrl, c, meas, inj)
+    q0 = float(meas.q[0])
+    x = np.array([q0, 0.0, 0.0, 0.0, I0, 0.0, sig0, q0, q0, 0.0])
+    u = np.empty(meas.n)
+    _replay(c, np.ascontiguousarray(meas.q_ref), np.ascontiguousarray(meas.q), inj, x, meas.dt, u)
+    return u
 
 
 def position_rms_error(meas: Measurement, model: NominalModel) -> float:

@@ -170,7 +170,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .force import Library, select
-    from .guards import check_inputs, check_units
+    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_units, same_record
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -178,6 +178,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     tick = _Progress(progress, 2 + sum(getattr(CAUSES[n], "CHANNEL", "force") != "force" for n in names))
     if not (isinstance(max_causes, (int, np.integer)) and 1 <= max_causes <= 4):
         raise SystemDefinitionError(f"max_causes = {max_causes!r} must be an integer in [1, 4]")
+    same = validate is not None and same_record(fit, validate)
     if validate is None:
         if fit.n < 250:
             raise SystemDefinitionError(f"{fit.name}: {fit.n} samples are too few to split into fitting and validation "
@@ -185,6 +186,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         t_split = fit.t[0] + 0.6 * (fit.t[-1] - fit.t[0])
         fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
     notes: list = list(check_inputs(fit, validate, model))
+    if same:
+        notes.append(SAME_DATA_NOTE.format(validate.name))
+    notes += [n for n in (check_controller(m, model) for m in ((fit,) if same else (fit, validate))) if n]
     if window is None:
         window = default_window(fit, validate, model)
     sensor = dict(resolution=model.resolution, noise=model.sensor_noise)
@@ -260,12 +264,29 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         res = model.resolution if model.resolution is not None else resolution_of(validate.q)
         sims = {"nominal": resimulate(validate, model), "extended": resimulate(validate, ext)}
         view = compare(validate, sims, model.cm, res)
+        if result:
+            notes += worse_resimulation(view)
     elif behaviour:
         notes.append("behaviour view skipped: it needs the model's 'controller' and the reference q_ref in the data")
     tick("done")
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
                      fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
                      fc["explanations"])
+
+
+def worse_resimulation(view: dict) -> list:
+    """Notes (list of str) for the behaviour view's re-simulation errors that the extended model
+    makes larger than the nominal one: the causes were selected on their own channels' metrics,
+    and a re-simulation they worsen must be said, not left in the table."""
+    from .causes._words import _q
+    out = []
+    for key, label, unit in (("position_rms", "position", "m"), ("force_rms", "drive force", "N")):
+        a, b = view["nominal"].get(key), view["extended"].get(key)
+        if a is not None and b is not None and np.isfinite(a) and b > a:
+            out.append(f"the extended model re-simulates the validation run worse than the nominal one: {label} RMS "
+                       f"error {_q(a, None, unit)} -> {_q(b, None, unit)} (+{(b / a - 1) if a > 0 else np.inf:.0%}); its "
+                       "causes were selected on the force residual and their own metrics, not on the re-simulation")
+    return out
 
 
 WINDOW_CYCLES = 0.5      # the smoothing window, in periods of the loop's bandwidth (at least 31 samples)

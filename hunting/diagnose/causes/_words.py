@@ -39,3 +39,8 @@ def _pct(x: float) -> str:
     """A share as a percentage with two significant digits ('48 %', '3.1 %')."""
     p = 100 * x
     return f"{p:.2g} %" if p < 10 else f"{p:.0f} %"
+
+
+def _count(n: int, noun: str, plural: str | None = None) -> str:
+    """'1 sample', '0 samples', '3 rests': a count with its noun in the right number."""
+    return f"{n} {noun if n == 1 else (plural or noun + 's')}"

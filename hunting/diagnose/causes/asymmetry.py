@@ -49,7 +49,11 @@ def extend(model, theta, hyper):
 def sentence(p, inc, model) -> str:
     parts = []
     for key, side, c in (("b_pos", "positive", model.curve.positive), ("b_neg", "negative", model.curve.negative)):
-        rel = p[key] / c.b - 1 if c.b else float("inf")
+        if not c.b:
+            parts.append(f"lacks the viscous friction for {side} velocities ({key} = {_q(p[key], None, 'N s/m')}; "
+                         "the model has none)")
+            continue
+        rel = p[key] / c.b - 1
         if abs(rel) >= 0.005:
             word = "underestimates" if rel > 0 else "overestimates"
             parts.append(f"{word} viscous friction for {side} velocities by {_pct(abs(rel))} "

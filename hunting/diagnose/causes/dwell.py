@@ -20,7 +20,7 @@ one-sided t test over independent rests. Gain: the RMS of e on the validation da
 nominal (the model's break-away force) against extended."""
 import numpy as np
 from scipy import stats
-from ._words import _q
+from ._words import _count, _q
 
 NAME = "dwell"
 DESCRIPTION = "break-away force growing with the time at rest"
@@ -98,7 +98,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     from ..model import Dwell
     t, F, s = rests(fit, model, resolution)
     if t.size < MIN_RESTS:
-        return dict(reason=f"{t.size} rests ending in motion in the fitting data (need {MIN_RESTS})", untestable=True)
+        return dict(reason=f"{_count(t.size, 'rest')} ending in motion in the fitting data (need {MIN_RESTS})", untestable=True)
     if np.ptp(t) < 0.5 * np.mean(t):
         return dict(reason=f"the rests all last about {np.mean(t):.3g} s: a dwell effect cannot be told from Fs", untestable=True)
     e = excess(model, t, F, s)
@@ -111,7 +111,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
                     reason=f"the break-away force falls with the rest (gain {th[1]:.3g} N): not a dwell effect")
     tv, Fv, sv = rests(validate, model, resolution)
     if tv.size < 3:
-        return dict(reason=f"{tv.size} rests ending in motion in the validation data (need 3)", untestable=True)
+        return dict(reason=f"{_count(tv.size, 'rest')} ending in motion in the validation data (need 3)", untestable=True)
     # out of sample: does the growth fitted on the fitting rests explain the validation rests'
     # break-away excess beyond a constant level (a wrong Fs)? One-sided t test of gamma in
     # e_v - level0 = gamma (prediction - level0) + eps over independent rests

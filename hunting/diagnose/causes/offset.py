@@ -28,5 +28,5 @@ def extend(model, theta, hyper):
 def sentence(p, inc, model) -> str:
     side = "negative" if p["offset"] > 0 else "positive"
     return (f"a constant force of {_q(abs(p['offset']), None, 'N')} pushes the load towards {side} positions "
-            f"(the model has {_q(model.offset, None, 'N')}; a Coulomb level differing by twice that between the "
+            f"(the model has {_q(model.offset, None, 'N') if model.offset else 'none'}; a Coulomb level differing by twice that between the "
             "directions looks the same while the load moves)")

@@ -12,6 +12,8 @@ data (needs the controller and the reference)."""
 import numpy as np
 from scipy import stats
 
+from ._words import _count
+
 NAME = "saturation"
 DESCRIPTION = "controller output saturation missing from the model"
 CHANNEL = "own"
@@ -39,7 +41,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     p = float(stats.binom.sf(top - 1, top + below, 0.5)) if top > 0 else 1.0
     out = dict(statistic=float(top), p_value=p)
     if top < MIN_AT_BOUND or U <= 0:
-        return dict(out, reason=f"the controller output does not pile up at a bound ({top} samples at its extreme)")
+        return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its extreme)")
     sat = model.controller.get("saturation", np.inf) if model.controller else np.inf
     if abs(sat - U) <= 0.01 * U:
         return dict(out, reason=f"the model already saturates at {sat:.4g}")

@@ -76,6 +76,11 @@ def extend(model, theta, hyper):
 
 def sentence(p, inc, model) -> str:
     c = model.curve.positive
+    if not (c.Fs > c.Fc or model.curve.negative.Fs > model.curve.negative.Fc):
+        # a curve without a dip has no static level or Stribeck velocity of its own to quote
+        return (f"friction at low speed differs from the model's, which has no Stribeck dip: static level Fs = "
+                f"{_q(p['Fs'], None, 'N')}, Coulomb level Fc = {_q(p['Fc'], None, 'N')} (model {_q(c.Fc, None, 'N')}), "
+                f"Stribeck velocity vs = {_q(p['vs'], None, 'm/s')}")
     return (f"friction at low speed differs from the model's: static level Fs = {_q(p['Fs'], None, 'N')} "
             f"(model {_q(c.Fs, None, 'N')}), Coulomb level Fc = {_q(p['Fc'], None, 'N')} (model "
             f"{_q(c.Fc, None, 'N')}), Stribeck velocity vs = {_q(p['vs'], None, 'm/s')} (model {_q(c.vs, None, 'm/s')})")

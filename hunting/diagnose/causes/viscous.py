@@ -35,6 +35,8 @@ def extend(model, theta, hyper):
 
 def sentence(p, inc, model) -> str:
     b0 = model.curve.positive.b
-    ratio = p["b"] / b0 if b0 else float("inf")
+    if not b0:
+        return f"viscous friction that the model lacks (b = {_q(p['b'], None, 'N s/m')}; the model has none)"
+    ratio = p["b"] / b0
     return (f"viscous friction is {ratio:.3g} times the model's (b = {_q(p['b'], None, 'N s/m')} instead of "
             f"{_q(b0, None, 'N s/m')})")
