@@ -571,7 +571,7 @@ def test_servo_loop_description_with_cogging_and_asymmetric_friction():
                            external_force=0.4),
                      Switch(DirectionalCurve(StribeckCurve(1.0, 1.5, 0.05, 0.7, 0.2), StribeckCurve(0.8, 1.1, 0.03, 2.0, 0.3))),
                      PID(20.0, 3.0, 10.0))
-    m = loop.as_model()
+    m = hunting.model(loop.description())
     assert set(m.param_names) >= {"kp", "kd", "ki", "Fc_neg", "cog_a2", "f_ext"}
     rng = np.random.default_rng(3)
     for _ in range(5):

@@ -98,12 +98,6 @@ class ServoLoop:
             v.update(cog_period=cog.period, cog_cos=cog.data[0::2], cog_sin=cog.data[1::2])
         return servo_description(v, name=self.name)
 
-    def as_model(self):
-        """This loop compiled from its description (:meth:`description`): a
-        ``hunting.CompiledModel`` with named parameters (kp, kd, ki, Fc, ...)."""
-        from ..describe import model
-        return model(self.description())
-
     @property
     def n_states(self) -> int:
         return 4 if self.model_code == S.MODEL_LUGRE else 3
