@@ -170,3 +170,13 @@ def test_cycle_summary_lists_the_mechanical_states_not_block_realizations(tmp_pa
     ranges = out.splitlines()[2]
     assert ranges.lstrip().startswith("q in [") and " v in [" in ranges
     assert "internal block states" in ranges and "u_1" not in ranges
+
+
+def test_continue_says_the_fold_and_its_multiplier_crossing_once(capsys):
+    """The fold's lambda2 = +1 crossing is one point, printed on the fold's line (it used to
+    be a second line, 'multiplier_+1', at a slightly different estimate)."""
+    assert main(["continue", "table8.1-lugre", "--param", "K", "--from", "0.6", "--to", "0.7"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    fold = [s for s in lines if s.startswith("fold")]
+    assert len(fold) == 1 and "K = 0.620296" in fold[0] and "a multiplier passes +1 here" in fold[0]
+    assert not any(s.startswith("multiplier_+1") for s in lines)

@@ -140,8 +140,17 @@ def run(args, results) -> int:
                 period_guess=args.period_guess, stop_at=args.back_to if args.back_to is not None else args.start)
     end = outcome(br, args.param, args.start, args.end, args.back_to)
     print(f"{len(br.mu)} points: {tell(args, end.line)}")
+    def same_place(a, b) -> bool:       # two estimates of one point, each within its bracket
+        return abs(a.param - b.param) <= 2 * (a.precision + b.precision) + 1e-6 * abs(a.param)
+
+    folds = [s for s in br.special if s.kind == "fold"]
+    crossings = [s for s in br.special if s.kind == "multiplier_+1"]
     for s in br.special:
-        print(f"{s.kind:<16} {args.param} = {s.param:.8g}  (interval width {s.precision:.2g})")
+        if s.kind == "multiplier_+1" and any(same_place(s, f) for f in folds):
+            continue                     # the fold's own multiplier crossing: said on the fold's line
+        crossing = s.kind == "fold" and any(same_place(s, c) for c in crossings)
+        print(f"{s.kind:<16} {args.param} = {s.param:.8g}  (interval width {s.precision:.2g})"
+              + ("  a multiplier passes +1 here" if crossing else ""))
     if args.json:
         out = br.as_dict()
         out.update(requested={"from": args.start, "to": args.end, "back_to": args.back_to},
