@@ -231,3 +231,10 @@ def test_dev_null_twice_with_stdout_on_dev_null(tmp_path):
     after = os.lstat("/dev/null")
     assert r.returncode == 0 and r.stderr == "", r.stderr
     assert stat.S_ISCHR(after.st_mode) and after.st_ino == before.st_ino
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full on this system")
+def test_a_device_that_fails_on_write_is_named(capsys):
+    code = main(["simulate", "table9.1", "--x0", "0.1,0,0", "--t", "0.5", "--json", "/dev/full"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and len(err) == 1 and "'/dev/full'" in err[0] and "could not be written" in err[0]

@@ -388,8 +388,14 @@ class Results:
             self._stdout.write(text if text.endswith("\n") else text + "\n")
             self._stdout.flush()
             return
-        with atomic_path(target) as tmp:
-            tmp.write_text(text)
+        try:
+            with atomic_path(target) as tmp:
+                tmp.write_text(text)
+        except OSError as e:
+            if e.filename is not None:
+                raise
+            # a device that fails on write (/dev/full) names no file: name the output that failed
+            raise OSError(e.errno, f"the result could not be written ({e.strerror or e})", target) from e
 
     def write_json(self, target: str, data, **dumps) -> None:
         self.write_text(target, json.dumps(data, **dumps))
