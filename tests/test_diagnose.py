@@ -94,6 +94,7 @@ def test_single_effect_is_named_first_with_its_final_parameters(case):
         assert c.parameters["lag"] == pytest.approx(0.02, rel=0.25)
     if case == "reversal":
         assert c.parameters["sigma0"] == pytest.approx(1e5, rel=0.3)
+        assert 0.7 < c.parameters["scale"] < 1.2            # the whole level builds up after a reversal
     assert all(s is not None and s > 0 for k, s in c.sigma.items() if k not in ("scale",)), c.sigma
 
 
@@ -216,6 +217,7 @@ def test_emps_default_columns_show_the_mismatch(tmp_path):
     assert dg.causes[0].name == "asymmetry"
     p = dg.causes[0].parameters
     assert p["b_pos"] < 185.0 and p["b_neg"] > 235.0           # published 166.7 and 240.4
+    assert p["b_pos"] == pytest.approx(166.7, rel=0.10) and p["b_neg"] == pytest.approx(240.4, rel=0.10)
     assert dg.extended < 0.5 * dg.nominal
     b = dg.behaviour
     assert b["extended"]["force_rms"] < 0.7 * b["nominal"]["force_rms"]
@@ -288,6 +290,7 @@ def test_cli_diagnose_prints_the_report_and_writes_the_json_contract(tmp_path, c
     assert "prewhitened" in out["rule"]
     assert (tmp_path / "rep" / "index.html").is_file() and (tmp_path / "rep" / "residual.png").stat().st_size > 10_000
     assert "Rule" in (tmp_path / "rep" / "index.html").read_text() or "Criterion" in (tmp_path / "rep" / "index.html").read_text()
+    assert "<p>Rule: " in (tmp_path / "rep" / "index.html").read_text()
 
 
 def _virtual_limms_model(mot, controller, cogging):

@@ -43,7 +43,7 @@ PRECISION_WORDS = 10.0   # reports call a residual "numerical precision" up to t
 class Variant:
     """One hyper-parameter variant of a cause: its regressors on the fitting and validation
     records (n, k) and the known, unfitted force change (n,) (zeros without one); Xr, sr : the
-    same on the validation record's reference trajectory (None without one)."""
+    same on the validation record's reference trajectory (noise-fed causes; None otherwise)."""
 
     name: str
     hyper: dict
@@ -112,7 +112,7 @@ class Library:
         v = Variant(name, hyper, mod.design(kf, model, hyper), mod.design(kv, model, hyper),
                     shift(kf, model, hyper) if shift else np.zeros(kf.t.size),
                     shift(kv, model, hyper) if shift else np.zeros(kv.t.size))
-        if kr is not None:
+        if kr is not None and getattr(mod, "NOISE_FED", False):      # only these are tested along it
             v.Xr = mod.design(kr, model, hyper)
             v.sr = shift(kr, model, hyper) if shift else np.zeros(kr.t.size)
         return v
@@ -210,29 +210,33 @@ class Library:
         return self.fit([(n, cur[n]) for n in names])
 
     # --- predictions ------------------------------------------------------------------------
-    def prediction(self, ex: Explanation, which: str) -> np.ndarray:
-        """The explanation's force change (n,) on the fitting ("f") or validation ("v") record, or
-        along the validation record's reference trajectory ("r")."""
-        n = (self.rf if which == "f" else self.rv).size
-        out = np.zeros(n)
+    def _members(self, ex: Explanation):
+        """(name, variant, its coefficients) of each member of a fitted explanation."""
         k = 0
         for name, j in ex.members:
             v = self.variants[name][j]
-            X, s = {"f": (v.Xf, v.sf), "v": (v.Xv, v.sv), "r": (v.Xr, v.sr)}[which]
-            out += X @ ex.theta[k:k + X.shape[1]] + s
-            k += X.shape[1]
+            yield name, v, ex.theta[k:k + v.Xf.shape[1]]
+            k += v.Xf.shape[1]
+
+    @staticmethod
+    def _term(v: Variant, theta: np.ndarray, which: str) -> np.ndarray:
+        X, s = {"f": (v.Xf, v.sf), "v": (v.Xv, v.sv), "r": (v.Xr, v.sr)}[which]
+        return X @ theta + s
+
+    def prediction(self, ex: Explanation, which: str) -> np.ndarray:
+        """The explanation's force change (n,) on the fitting ("f") or validation ("v") record."""
+        out = np.zeros((self.rf if which == "f" else self.rv).size)
+        for _, v, theta in self._members(ex):
+            out += self._term(v, theta, which)
         return out
 
     def part(self, ex: Explanation, name: str, which: str) -> np.ndarray:
-        """One member's force change (n,) in a fitted explanation (prediction's terms)."""
-        k = 0
-        for nm, j in ex.members:
-            v = self.variants[nm][j]
-            kk = v.Xf.shape[1]
+        """One member's force change (n,) in a fitted explanation on the fitting ("f") or
+        validation ("v") record, or along the validation record's reference trajectory ("r",
+        noise-fed causes only)."""
+        for nm, v, theta in self._members(ex):
             if nm == name:
-                X, s = {"f": (v.Xf, v.sf), "v": (v.Xv, v.sv), "r": (v.Xr, v.sr)}[which]
-                return X @ ex.theta[k:k + kk] + s
-            k += kk
+                return self._term(v, theta, which)
         raise KeyError(name)
 
     def validation_rms(self, ex: Explanation) -> float:
@@ -263,7 +267,7 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
     e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
     noise_v = NoiseModel.fit(e_full, Sv.run)
     current = ranking[0]
-    floor = PRECISION * float(np.sqrt(np.mean(lib.kv.force[lib.used_v] ** 2)))
+    floor = PRECISION * _rms(lib.kv.force[lib.used_v])
     while True:
         tests = {}
         rms_full = lib.validation_rms(current)

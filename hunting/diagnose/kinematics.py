@@ -62,6 +62,11 @@ class Kinematics:
     def dt(self) -> float:
         return float(self.t[1] - self.t[0])
 
+    def delayed_drive(self, delay: float) -> np.ndarray:
+        """The drive [N] (n,) delayed by ``delay`` [s] >= 0: linear interpolation of the
+        ZOH-aligned drive (exact for whole samples), held at its first value before it starts."""
+        return np.interp(self.t - delay, self.t, self.drive) if delay > 0 else self.drive
+
     def filtered(self, x: np.ndarray) -> np.ndarray:
         """H_a x for x (n,) or (n, k): the filter the acceleration and the drive force went
         through."""
@@ -226,7 +231,7 @@ def residual(kin: Kinematics, model) -> np.ndarray:
     sliding = model.friction(kin.vf) + model.lag_force(kin.vf, kin.a_inst)
     if model.flexibility is not None:
         sliding = sliding + model.flexibility.force(kin.a_inst, kin.dt)
-    drive = np.interp(kin.t - model.delay, kin.t, kin.drive) if model.delay > 0 else kin.drive
+    drive = kin.delayed_drive(model.delay)
     need = drive - model.offset - cog
     grow = (model.dwell.level + model.dwell.gain) if model.dwell is not None else 0.0
     stick_set = np.clip(need, -model.curve.negative.Fs - grow, model.curve.positive.Fs + grow)

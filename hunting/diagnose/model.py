@@ -131,7 +131,7 @@ _DESCRIPTION_KEYS = {"states", "equations", "signals", "parameters", "blocks"}
 _DESCRIPTION_NOT_NOMINAL = ("model file {path} is a model description (states and equations, the format of "
                             "'hunting simulate --model'); diagnose takes a nominal model JSON with the keys plant, "
                             "friction, controller, sensor (format in 'hunting diagnose --help', example: "
-                            "examples/emps/model.json)")
+                            "examples/emps/model.json in a checkout, or emps_model.json from 'hunting data emps')")
 
 
 def _looks_like_description(text: str) -> bool:
@@ -280,7 +280,7 @@ class NominalModel:
             raise SystemDefinitionError(f"model file {path} is not JSON ({exc.msg} at line {exc.lineno} column "
                                         f"{exc.colno}); diagnose takes a nominal model JSON, see 'hunting diagnose "
                                         "--help' and examples/emps/model.json") from None
-        if isinstance(d, dict) and {"states", "equations"} & set(d):
+        if isinstance(d, dict) and _DESCRIPTION_KEYS & set(d):
             raise SystemDefinitionError(_DESCRIPTION_NOT_NOMINAL.format(path=path))
         return NominalModel.from_dict(d)
 

@@ -209,7 +209,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         kr = reference_kinematics(validate, model, window=window)
         lib = Library(force_names, kf, kv, model, kf.moving, kv.moving, step, kr)
         untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
-        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference))
+        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference), min_gain)
     else:
         if force_names:
             why = ("fewer than 100 sliding samples (|v| > 2 % of the maximum, half a filter window from stops and "
@@ -368,7 +368,7 @@ def _members_parameters(lib, ex, cov=None) -> list:
     return out
 
 
-def _force_channel(lib, model, sel) -> dict:
+def _force_channel(lib, model, sel, min_gain: float) -> dict:
     """Causes, extended model, residuals and alternatives from the force channel's selection."""
     from .force import compatible, refine
     ex = sel["explanation"]
@@ -390,7 +390,7 @@ def _force_channel(lib, model, sel) -> dict:
     ext = rows[-1][6] if rows else model
     nominal_rms = _rms(lib.rv[mv])
     # alternatives: (1) a cause of a selected one's family in its place; (2) a cause that explains
-    # the data alone (better BIC than the nominal model, validation gain >= 2 %) but not once the
+    # the data alone (better BIC than the nominal model, validation gain >= min_gain) but not once the
     # selected ones are in
     alternatives, seen = [], {c.name for c in causes}
     fits = sel["fits"]
@@ -419,7 +419,7 @@ def _force_channel(lib, model, sel) -> dict:
         if not alone.physical:
             continue
         rms1 = lib.validation_rms(alone)
-        if alone.bic < empty.bic and rms1 < 0.98 * nominal_rms:
+        if alone.bic < empty.bic and rms1 < (1 - min_gain) * nominal_rms:
             row = _members_parameters(lib, alone)[0]
             alternatives.append(dict(name=name, kind="alone", absorbed_by=sorted(chosen), parameters=row[3],
                                      bic_difference=float(alone.bic - ex.bic),

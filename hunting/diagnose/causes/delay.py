@@ -28,8 +28,7 @@ def hyper_bounds(kin, model) -> dict:
 def design(kin, model, hyper):
     # on top of the model's own delay (the residual's drive is already delayed by it)
     tau, d0 = hyper["tau"], model.delay
-    now = np.interp(kin.t - d0, kin.t, kin.drive) if d0 > 0 else kin.drive
-    late = np.interp(kin.t - d0 - tau, kin.t, kin.drive)
+    now, late = kin.delayed_drive(d0), kin.delayed_drive(d0 + tau)
     return kin.sliding((now - late) / tau)[:, None]
 
 
