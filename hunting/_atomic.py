@@ -161,14 +161,16 @@ def atomic_path(path, *, fifo_wait: float = FIFO_WAIT) -> Iterator[Path]:
     if target.kind == "stream":
         keep = _wait_for_reader(target.path, fifo_wait) if target.fifo else None
         try:
-            yield target.path
+            with _named(path):
+                yield target.path
         finally:
             if keep is not None:
                 os.close(keep)
         return
     tmp = _create_temp(target.path)
     try:
-        yield tmp
+        with _named(path):
+            yield tmp
         if target.mode is not None:
             os.chmod(tmp, target.mode)
             if target.owner is not None and target.owner != (os.geteuid(), os.getegid()):
@@ -179,6 +181,18 @@ def atomic_path(path, *, fifo_wait: float = FIFO_WAIT) -> Iterator[Path]:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+@contextlib.contextmanager
+def _named(path) -> Iterator[None]:
+    """A write that fails without naming a file (ENOSPC on /dev/full or a full disk) names
+    ``path``, the output the user gave."""
+    try:
+        yield
+    except OSError as e:
+        if e.filename is not None:
+            raise
+        raise OSError(e.errno, f"the result could not be written ({e.strerror or e})", str(path)) from e
 
 
 def _replace(tmp: Path, path: Path) -> None:

@@ -211,3 +211,5 @@ def test_belt_branch_passes_where_the_orbit_leaves_its_first_phase_plane():
     assert br.stable.all()
     ref = find_cycle(system, params={"k": 0.3})
     assert ref.success and br.period[-1] == pytest.approx(ref.period, rel=1e-6)
+    from cycle_systems import belt_reference_cycle          # scipy solve_ivp with the stick event
+    assert br.period[-1] == pytest.approx(belt_reference_cycle(k=0.3)["period"], rel=1e-6)

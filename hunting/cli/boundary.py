@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_path, output_target
+from .._atomic import output_target, write_text
 from ..errors import HuntingError
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
@@ -388,14 +388,7 @@ class Results:
             self._stdout.write(text if text.endswith("\n") else text + "\n")
             self._stdout.flush()
             return
-        try:
-            with atomic_path(target) as tmp:
-                tmp.write_text(text)
-        except OSError as e:
-            if e.filename is not None:
-                raise
-            # a device that fails on write (/dev/full) names no file: name the output that failed
-            raise OSError(e.errno, f"the result could not be written ({e.strerror or e})", target) from e
+        write_text(target, text)
 
     def write_json(self, target: str, data, **dumps) -> None:
         self.write_text(target, json.dumps(data, **dumps))
