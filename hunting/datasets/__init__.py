@@ -34,12 +34,13 @@ from importlib import resources
 from pathlib import Path
 from typing import NamedTuple
 
+from .._userdirs import CACHE_ENV, cache_root
 from ..errors import HuntingError
 
 log = logging.getLogger(__name__)
 
 ENV_DATA = "HUNTING_DATA"
-ENV_CACHE = "HUNTING_CACHE_DIR"          # shared with the model cache (hunting.describe.cache)
+ENV_CACHE = CACHE_ENV          # shared with the model cache (hunting.describe.cache)
 
 # The publisher's archive: nonlinearbenchmark.org's file host, as used by the benchmark's own
 # data loader (github.com/GerbenBeintema/nonlinear_benchmarks, nonlinear_benchmarks/benchmarks.py,
@@ -100,13 +101,9 @@ def verify(path, expected: str, label: str | None = None, advice: str = _LOCAL_A
 
 
 def cache_dir() -> Path:
-    """The user data cache: ``$HUNTING_CACHE_DIR/data``, else pooch's per-user cache
-    (``~/.cache/hunting/data`` on Linux). Not created here."""
-    root = os.environ.get(ENV_CACHE)
-    if root:
-        return Path(root).expanduser() / "data"
-    import pooch
-    return Path(pooch.os_cache("hunting")) / "data"
+    """The user data cache: ``data`` under the cache root the compiled models share
+    (``$HUNTING_CACHE_DIR``, ``$XDG_CACHE_HOME/hunting`` or ``~/.cache/hunting``). Not created here."""
+    return cache_root() / "data"
 
 
 def _project_root() -> Path | None:

@@ -16,21 +16,16 @@ import sys
 import tempfile
 from pathlib import Path
 
+from .._userdirs import CACHE_ENV, cache_root
 from ..errors import SystemDefinitionError
 
-ENV_VAR = "HUNTING_CACHE_DIR"
+ENV_VAR = CACHE_ENV
 _loaded: dict = {}       # digest -> (module, meta): a model compiles and imports once per process
 
 
 def cache_dir() -> Path:
     """The directory holding generated model modules (created on first use)."""
-    root = os.environ.get(ENV_VAR)
-    if root:
-        base = Path(root).expanduser()
-    else:
-        xdg = os.environ.get("XDG_CACHE_HOME")
-        base = (Path(xdg) if xdg else Path.home() / ".cache") / "hunting"
-    d = base / "models"
+    d = cache_root() / "models"
     try:
         d.mkdir(parents=True, exist_ok=True)
     except OSError as e:
