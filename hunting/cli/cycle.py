@@ -44,13 +44,12 @@ files = result_files
 def run(args, results) -> int:
     from ..continuation import StartOptions, find_cycle
     from ..plotting import cycle_panels, plot_cycle
-    choice = resolve_system(args)
-    names = list(choice.system.state_names)
-    x0 = args.x0.vector(names) if args.x0 else None
-    if args.which == "unstable" and x0 is not None and args.period_guess is None:
+    if args.which == "unstable" and args.x0 and args.period_guess is None:     # before compiling a model
         raise UsageError("--which unstable needs no --x0 (the event map of a preset or of a model with one "
                          "Switch contact), or --x0 with --period-guess (shooting from there): a simulation never "
                          "settles on an unstable cycle")
+    choice = resolve_system(args)
+    x0 = args.x0.vector(list(choice.system.state_names)) if args.x0 else None
     start = StartOptions(t_max=args.t_max) if args.t_max is not None else None
     res = find_cycle(choice.source, x0, args.period_guess, choice.params, which=args.which, d_max=args.d_max,
                      start=start)

@@ -51,14 +51,14 @@ def thinned(m: int, max_samples: int):
 def run(args, results) -> int:
     from ..integrate import simulate
     from ..plotting import plot_trajectory
+    if args.growth != 0 and args.growth <= 1:            # before a model file is compiled
+        raise UsageError(f"--growth {args.growth:g} is not allowed: a factor > 1, or 0 for no check")
     choice = resolve_system(args)
     system = choice.system
     if args.x0:
         x0 = args.x0.vector(list(system.state_names))
     else:
         x0 = choice.model.state() if choice.model is not None else np.zeros(system.n_states)
-    if args.growth != 0 and args.growth <= 1:
-        raise UsageError(f"--growth {args.growth:g} is not allowed: a factor > 1, or 0 for no check")
     tr = simulate(system, x0, (0.0, args.t), method=args.method, rtol=args.rtol, atol=args.atol,
                   max_steps=args.max_steps, max_events=args.max_events, growth=args.growth or None)
     print(tell(args, tr.summary()))
