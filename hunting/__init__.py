@@ -20,11 +20,7 @@ _LAZY = {"simulate": ".integrate", "find_cycle": ".continuation", "follow": ".co
          **{n: ".system" for n in ("GUARD_SIG", "JAC_SIG", "MODE_SIG", "RESET_SIG", "VF_SIG", "Mode",
                                    "PiecewiseSystem")}}
 
-__all__ = ["ConvergenceError", "HuntingError", "Status", "SystemDefinitionError", "simulate", "PID",
-           "Cogging", "Coulomb", "DirectionalCurve", "Discontinuous", "LuGre", "Plant", "ServoLoop",
-           "StribeckCurve", "Switch", "Viscous", "preset", "EventLog", "Trajectory", "GUARD_SIG",
-           "JAC_SIG", "MODE_SIG", "RESET_SIG", "VF_SIG", "Mode", "PiecewiseSystem", "__version__",
-           "find_cycle", "follow", "model", "load_model", "ModelBuilder", "CompiledModel"]
+__all__ = ["ConvergenceError", "HuntingError", "Status", "SystemDefinitionError", "__version__", *_LAZY]
 
 
 def __getattr__(name: str):

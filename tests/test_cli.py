@@ -418,3 +418,14 @@ def test_diagnose_help_says_everything_the_controller_is_used_for(capsys):
     fed = [n for n, mod in CAUSES.items() if getattr(mod, "NOISE_FED", False)]
     at = text.index("noise-fed causes")
     assert fed and all(n in text[at:at + 200] for n in fed), fed
+
+
+def test_eventmap_says_the_slope_is_unbounded_where_the_map_jumps(capsys):
+    """beta = inf (the discontinuous curve): P jumps at d = 0, so the equilibrium has no finite
+    slope; the probe ratio P(delta)/delta (1.93e6 at the smallest probe) was printed as one."""
+    code, out, _ = run_main(capsys, ["eventmap", "table9.1", "--set", "beta=inf", "--grid", "0:0.5:11"])
+    line = next(ln for ln in out.splitlines() if ln.startswith("equilibrium"))
+    assert code == 0 and "slope unbounded (the map jumps at d = 0)" in line and "unstable" in line
+    code, out, _ = run_main(capsys, ["eventmap", "table9.1", "--grid", "0:0.5:11"])
+    line = next(ln for ln in out.splitlines() if ln.startswith("equilibrium"))
+    assert "slope -0.925624" in line and "stable" in line

@@ -23,7 +23,7 @@ COMMANDS = sorted(PARSER.commands)
 API_WORDS = re.compile(r"period_guess|t_max|d_max|max_steps|max_events|max_points|ds_min|ds_max|t_span|"
                        r"method='radau'|simulate's growth|transition function|find_cycle|\(x0\)|\(x0,|\btol\b")
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
-LIBRARY_ADVICE = sorted({*library_advice(), "the stick states are not a one-parameter family. Use find_cycle instead"})
+LIBRARY_ADVICE = sorted(set(library_advice()))
 
 
 def _command(name, model_file=False):

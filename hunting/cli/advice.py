@@ -185,7 +185,8 @@ def library_advice() -> list[str]:
     """Every advice text of the integrator's and the orbit methods' status codes."""
     from ..continuation.status import OrbitStatus
     from ..errors import Status, status_message
-    return [*(status_message(s) for s in Status), *(s.advice for s in OrbitStatus)]
+    from ..eventmap.family import NOT_A_FAMILY_ADVICE
+    return [*(status_message(s) for s in Status), *(s.advice for s in OrbitStatus), NOT_A_FAMILY_ADVICE]
 
 
 def _once(text: str) -> str:

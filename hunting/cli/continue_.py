@@ -17,7 +17,6 @@ from .systems import add_system_arguments, resolve_system
 
 NAME = "continue"
 HELP = "follow the hunting branch in one parameter (shooting + arclength)"
-_DEFAULT_DS = 0.05          # ContinuationOptions.ds: the first step, kept within --ds-min .. --ds-max
 
 
 def add_arguments(p) -> None:
@@ -133,7 +132,7 @@ def run(args, results) -> int:
     if args.start * args.end < 0 or 0.0 in (args.start, args.end):
         print(tell(args, f"note: the range of {args.param} includes 0; a model may be singular there "
                          "(e.g. a mass or a time constant)"))
-    ds = min(max(_DEFAULT_DS, args.ds_min), args.ds_max)
+    ds = min(max(ContinuationOptions.ds, args.ds_min), args.ds_max)     # the default first step, within the bounds
     options = ContinuationOptions(ds=ds, ds_min=args.ds_min, ds_max=args.ds_max, max_points=args.max_points)
     x0 = args.x0.vector(list(choice.system.state_names)) if args.x0 else None
     br = follow(choice.source, args.param, args.start, args.end, params=choice.params, options=options, x0=x0,

@@ -40,7 +40,7 @@ def run(args, results) -> int:
     res = check_resolution(em, fixed_points(loop, args.grid, args.iterate, emap=em))   # logs its warnings
     for f in res.fixed:
         note = "  (not bracketed by the grid: found by refining)" if f in res.unbracketed else ""
-        print(f"{f.kind:<12} d = {f.d:+.10f}  stick phases {f.iterate}  slope {f.slope:+.6g}  "
+        print(f"{f.kind:<12} d = {f.d:+.10f}  stick phases {f.iterate}  slope {_slope_words(f)}  "
               f"{'stable' if f.stable else 'unstable'}{note}")
     if args.json:
         results.write_json(args.json, {
@@ -62,3 +62,18 @@ def run(args, results) -> int:
     if args.plot:
         plot_event_map(em, fixed=res.fixed, title=f"{choice.label}: P^{args.iterate}", path=args.plot)
     return 0
+
+
+def _slope_words(f) -> str:
+    """The fixed point's slope as printed: a number, or what the map does at the origin when it
+    has no finite slope there (a probe ratio P(delta)/delta is not a slope)."""
+    behaviour = f.origin.behaviour if f.origin is not None else "linear"
+    if behaviour == "discontinuous":
+        return "unbounded (the map jumps at d = 0)"
+    if behaviour == "steep" and not np.isfinite(f.slope):
+        return "unbounded (slip grows away from d = 0)"
+    if behaviour == "steep":
+        return f"unbounded (P(d)/d still growing, {f.slope:+.3g} at the smallest probe)"
+    if behaviour == "undefined":
+        return "undefined (a probe near d = 0 failed)"
+    return f"{f.slope:+.6g}"

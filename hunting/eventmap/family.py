@@ -27,6 +27,12 @@ from ..system import PiecewiseSystem
 _N_PROBES = 6
 
 
+# what to do when a system's stick states cannot be mapped in one dimension (also rewritten
+# into command-line words by hunting.cli.advice)
+NOT_A_FAMILY_ADVICE = ("a 1-D stick-exit map needs exactly one frozen state (the stick error) and one that drifts "
+                       "(e.g. a PID servo's position error and integral). Use find_cycle instead")
+
+
 def _call(fn, mode, x, p, size):
     out = np.empty(size)
     fn(int(mode), 0.0, np.ascontiguousarray(x, dtype=np.float64), p, out)
@@ -306,10 +312,8 @@ def stick_family(obj, *, d_state: str | None = None, seed: int = 0) -> StickFami
         else:
             what = (f"in stick {len(evolve)} state(s) evolve ({', '.join(evolve) or 'none'}) and {len(stay)} stay "
                     f"frozen ({', '.join(stay) or 'none'})")
-        raise SystemDefinitionError(f"{name}: the stick states are not a one-parameter family: {what}; a 1-D "
-                                    f"stick-exit map needs exactly one frozen state (the stick error) and one that "
-                                    f"drifts (e.g. a PID servo's position error and integral). Use find_cycle "
-                                    f"instead")
+        raise SystemDefinitionError(f"{name}: the stick states are not a one-parameter family: {what}; "
+                                    f"{NOT_A_FAMILY_ADVICE}")
     di, ei = frozen[0], moving[0]
     # d0: the frozen value at which the drift stops (the drift is probed at two values of d)
     x = probes[0].copy()
