@@ -257,6 +257,24 @@ class PiecewiseSystem:
         self.guards(int(mode), float(t), x, self.params, out)
         return out
 
+    def time_dependent_mode(self, states, modes=None, *, guards: bool = False, params=None) -> int | None:
+        """The first mode whose vector field (and, with ``guards``, guard values) at one of
+        ``states`` (each shape (n,)) differs between t = 0 and t = 1.2345 (rtol 1e-12), or None:
+        a probe of time invariance. ``modes``: the mode indices to probe (default all);
+        ``params``: the parameter array (default the system's)."""
+        p = self.params if params is None else params
+        checks = [(self.vector_field, self.n_states)] + ([(self.guards, self.n_guards)] if guards else [])
+        for x in states:
+            x = np.ascontiguousarray(x, dtype=float)
+            for mode in (range(self.n_modes) if modes is None else modes):
+                for fn, size in checks:
+                    a, b = np.empty(size), np.empty(size)
+                    fn(int(mode), 0.0, x, p, a)
+                    fn(int(mode), 1.2345, x, p, b)
+                    if not np.allclose(a, b, rtol=1e-12, atol=1e-300, equal_nan=True):
+                        return int(mode)
+        return None
+
     def initial_mode(self, x, t: float = 0.0) -> int:
         x = self.check_state(x)
         m = int(self.mode_of(float(t), x, self.params))

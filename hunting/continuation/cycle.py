@@ -418,12 +418,7 @@ def stick_error_range(loop, max_doublings: int = 12) -> float:
     0.4
     """
     from ..eventmap import evaluate_map
-    if _is_family(loop):
-        D = loop.force_scale()
-    else:
-        lo, hi = loop.friction.stick_set
-        k = loop.plant.motor_constant * loop.controller.kp
-        D = max(abs(lo), abs(hi)) / k if k > 0 else 1.0
+    D = loop.force_scale() if _is_family(loop) else _servo_force_scale(loop)
     for _ in range(max_doublings):
         mv = evaluate_map(loop, [D] if loop.odd else [D, -D], 2)
         if np.all(mv.ok) and np.all(np.abs(mv.image) < D):
@@ -561,9 +556,15 @@ def _default_start(target: Target, smap=None) -> np.ndarray:
     qd = loop.plant.setpoint
     if qd != 0:
         return loop.state(x1=-qd)
+    return loop.state(x1=-_servo_force_scale(loop))
+
+
+def _servo_force_scale(loop) -> float:
+    """A servo loop's stick-error scale [position unit]: the larger stick bound over cm kp (the
+    error whose proportional force alone reaches it); 1.0 without proportional action."""
     lo, hi = loop.friction.stick_set
     k = loop.plant.motor_constant * loop.controller.kp
-    return loop.state(x1=-(max(abs(lo), abs(hi)) / k if k > 0 else 1.0))
+    return max(abs(lo), abs(hi)) / k if k > 0 else 1.0
 
 
 def _section_at(system: PiecewiseSystem, x: np.ndarray, T: float) -> int:
@@ -757,15 +758,10 @@ def _require_autonomous(target: Target) -> None:
     sys_ = target.system
     rng = np.random.default_rng(1)
     n = sys_.n_states
-    for x in (target.state(None), rng.normal(size=n), rng.normal(size=n)):
-        x = np.ascontiguousarray(x, dtype=float)
-        for mode in range(sys_.n_modes):
-            a, b = np.empty(n), np.empty(n)
-            sys_.vector_field(mode, 0.0, x, sys_.params, a)
-            sys_.vector_field(mode, 1.2345, x, sys_.params, b)
-            if not np.allclose(a, b, rtol=1e-12, atol=1e-300, equal_nan=True):
-                raise SystemDefinitionError(
-                    f"{target.label} depends on the time t (its vector field changes with t in mode "
-                    f"{sys_.modes[mode].name!r}): the cycle search needs an autonomous system. Write the drive "
-                    f"as states (e.g. a coordinate relative to a moving reference, q - vd*t, as a state), or "
-                    f"simulate the forced response instead")
+    mode = sys_.time_dependent_mode([target.state(None), rng.normal(size=n), rng.normal(size=n)])
+    if mode is not None:
+        raise SystemDefinitionError(
+            f"{target.label} depends on the time t (its vector field changes with t in mode "
+            f"{sys_.modes[mode].name!r}): the cycle search needs an autonomous system. Write the drive "
+            f"as states (e.g. a coordinate relative to a moving reference, q - vd*t, as a state), or "
+            f"simulate the forced response instead")

@@ -286,15 +286,9 @@ def stick_family(obj, *, d_state: str | None = None, seed: int = 0) -> StickFami
     probes[:, surface] = surface_value
     F = np.array([_call(sys_.vector_field, sm, x, p, n) for x in probes])
     # time invariance: the same field and guards at another time
-    for x in probes[:2]:
-        for fn, size in ((sys_.vector_field, n), (sys_.guards, sys_.n_guards)):
-            a = np.empty(size)
-            b = np.empty(size)
-            fn(int(sm), 0.0, x, p, a)
-            fn(int(sm), 1.2345, x, p, b)
-            if not np.allclose(a, b, rtol=1e-12, atol=1e-300):
-                raise SystemDefinitionError(f"{name}: event maps need a time-invariant system (its stick mode "
-                                            f"changes with t)")
+    if sys_.time_dependent_mode(probes[:2], [sm], guards=True, params=p) is not None:
+        raise SystemDefinitionError(f"{name}: event maps need a time-invariant system (its stick mode "
+                                    f"changes with t)")
     others = [i for i in range(n) if i != surface]
     frozen = [i for i in others if np.all(F[:, i] == 0.0)]
     moving = [i for i in others if i not in frozen]
