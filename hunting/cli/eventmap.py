@@ -28,7 +28,7 @@ files = result_files
 
 def run(args, results) -> int:
     from ..errors import Status
-    from ..eventmap import check_resolution, event_map, fixed_points, stick_family
+    from ..eventmap import check_resolution, event_map, stick_family
     from ..plotting import plot_event_map
     choice = resolve_system(args)
     if choice.model is not None:
@@ -37,7 +37,7 @@ def run(args, results) -> int:
         loop = choice.loop
         loop.require_stick_map()
     em = event_map(loop, args.grid, args.iterate, derivative=False)
-    res = check_resolution(em, fixed_points(loop, args.grid, args.iterate, emap=em))   # logs its warnings
+    res = check_resolution(em)          # its fixed points with the slope at d = 0 computed once; logs its warnings
     for f in res.fixed:
         note = "  (not bracketed by the grid: found by refining)" if f in res.unbracketed else ""
         print(f"{f.kind:<12} d = {f.d:+.10f}  stick phases {f.iterate}  slope {_slope_words(f)}  "

@@ -241,12 +241,14 @@ def _grid(grid) -> np.ndarray:
 
 def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
                  options: MapOptions | None = None, thesis_fits: bool = False,
-                 emap: EventMap | None = None) -> list[FixedPoint]:
+                 emap: EventMap | None = None, origin: OriginSlope | None = None) -> list[FixedPoint]:
     """All fixed points of P^k found on ``grid``, refined to |Δd| <= tol on the true map.
 
     Cycles are reported once per orbit (the largest stick error of the orbit as ``d``) with
     their minimal number of stick phases; the equilibrium set d = 0 is always reported when the
-    grid spans or touches 0. ``thesis_fits`` adds the thesis' local fits for comparison."""
+    grid spans or touches 0. ``thesis_fits`` adds the thesis' local fits for comparison;
+    ``origin``: the slope at d = 0 when already computed (:func:`origin_slope` of the same loop
+    and ``iterate`` at the grid's extent), so it is not computed again."""
     loop = as_stick_map(loop)            # a preset name, compiled model or PiecewiseSystem as well
     opt = options or MapOptions()
     grid = _grid(grid) if emap is None else emap.grid
@@ -256,7 +258,9 @@ def fixed_points(loop: ServoLoop, grid, iterate: int = 2, *, tol: float = 1e-12,
     i = np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(g[:-1]) * np.sign(g[1:]) < 0)
                        & (em.grid[:-1] * em.grid[1:] > 0))
     scale = max(np.max(np.abs(grid)), opt.d_floor)
-    os_ = origin_slope(loop, iterate, scale, opt) if grid.min() <= 0 <= grid.max() else None
+    os_ = None
+    if grid.min() <= 0 <= grid.max():
+        os_ = origin if origin is not None else origin_slope(loop, iterate, scale, opt)
     extra = _origin_brackets(loop, em, g, os_, iterate, opt) if os_ is not None else []
     lo = np.concatenate([em.grid[i], [e[0] for e in extra]])
     hi = np.concatenate([em.grid[i + 1], [e[1] for e in extra]])

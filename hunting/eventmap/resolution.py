@@ -155,11 +155,13 @@ def check_resolution(em: EventMap, fixed: list[FixedPoint] | None = None, *, bud
     MapResolution; its warnings are also logged (logger ``hunting.eventmap.resolution``)."""
     loop, k, opt = em.loop, em.iterate, em.options
     grid = em.grid
-    fixed = fixed_points(loop, grid, k, emap=em, options=opt) if fixed is None else fixed
     budget = max(4 * grid.size, 200) if budget is None else int(budget)
     h = float(np.max(np.diff(grid))) if grid.size > 1 else 0.0
     spans_zero = grid.min() <= 0 <= grid.max()
-    os_ = origin_slope(loop, k, float(np.max(np.abs(grid))), opt, probes=True) if spans_zero else None
+    # once, with the probes (they say how far the map is linear), for every fixed-point search here
+    os_ = (origin_slope(loop, k, max(float(np.max(np.abs(grid))), opt.d_floor), opt, probes=True)
+           if spans_zero else None)
+    fixed = fixed_points(loop, grid, k, emap=em, options=opt, origin=os_) if fixed is None else fixed
     g0 = None
     if os_ is not None and os_.behaviour == "linear" and np.isfinite(os_.slope_right):
         g0 = float(np.sign(os_.slope_right - 1.0))
@@ -216,7 +218,7 @@ def check_resolution(em: EventMap, fixed: list[FixedPoint] | None = None, *, bud
                                 f"the range where P^{k} is linear (P^{k}(d)/d = {secant:.4g} there, {slope:.4g} at "
                                 f"d -> 0, linear up to about |d| = {d_lin:.2g}): {why}")
     # fixed points: those on every evaluated point that the grid alone does not bracket
-    all_fixed = fixed_points(loop, refined.grid, k, emap=refined, options=opt)
+    all_fixed = fixed_points(loop, refined.grid, k, emap=refined, options=opt, origin=os_)
     known = [f.d for f in fixed if f.kind == "cycle"]
     missed = [f for f in all_fixed if f.kind == "cycle"
               and not any(abs(f.d - d) <= 1e-7 * max(abs(f.d), opt.d_floor) for d in known)]
