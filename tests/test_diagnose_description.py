@@ -23,13 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PD_JSON = {"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 0.0},
            "friction": {"law": "coulomb-viscous", "Fc": 20.0, "b": 200.0},
            "controller": {"type": "pid", "kp": 38880.0, "kd": 243.0, "ki": 0.0, "derivative_on": "measurement"}}
-PD_DESCRIPTION = {
-    "name": "emps-like servo",
-    "parameters": {"m": 95.0, "cm": 35.15, "Fc": 20.0, "b": 200.0, "kp": 160.0, "kv": 243.0, "q_ref": 0.0},
-    "states": ["q", "v"],
-    "signals": {"u": "kv*(kp*(q_ref - q) - v)"},
-    "equations": {"q": "v", "v": "(cm*u - F)/m"},
-    "friction": {"force": "F", "velocity": "v", "model": "switch", "slip": "sign(w)*Fc + b*w", "stick": "Fc"}}
+PD_DESCRIPTION = json.loads((ROOT / "examples" / "pd_servo.json").read_text())    # README's example
 
 # Direction-dependent Stribeck levels, an offset, a viscous term written in the equation, and a
 # PID with a filtered derivative on the error as one transfer-function block.
@@ -162,3 +156,20 @@ def test_a_description_without_a_reading_is_one_line_and_exit_2(tmp_path, capsys
     if not isinstance(description, dict):
         with pytest.raises(SystemDefinitionError, match="no reading|not a velocity|contacts|not of the"):
             nominal_from_description(description)
+
+
+def test_docstring_examples():
+    import doctest
+
+    from hunting.describe import mechanical
+    from hunting.diagnose import from_description
+    for mod in (mechanical, from_description):
+        res = doctest.testmod(mod)
+        assert res.failed == 0 and res.attempted > 0
+
+
+def test_an_open_loop_description_has_no_controller_and_its_gain_is_read():
+    """u a parameter (the data's u drives the plant directly): no controller, cm read off."""
+    d = _variant(parameters={"m": 95.0, "cm": 35.15, "Fc": 20.0, "b": 200.0, "u": 0.0}, signals={})
+    model = nominal_from_description(d)
+    assert model.controller is None and model.cm == 35.15 and model.mass == 95.0

@@ -69,7 +69,7 @@ class MechanicalParameters:
     """One mechanical degree of freedom with one friction contact, read off a description.
 
     position, velocity : the state names of q and v = q'; mass [kg]; drive : the name of the
-    signal (or parameter) u that the motor constant multiplies, or None; cm [N per unit of u];
+    signal, block output or parameter u that the motor constant multiplies; cm [N per unit of u];
     offset [N] : constant force in m v' = cm u - F(v) - offset; law : "switch" or "lugre"; curve :
     the friction's :class:`DirectionalCurve` (viscous terms of the equation included in its b);
     sigma0 [N/m], sigma1 [N s/m] : LuGre's (None for switch); controller : a :class:`PIDReading`
@@ -78,7 +78,7 @@ class MechanicalParameters:
     position: str
     velocity: str
     mass: float
-    drive: str | None
+    drive: str
     cm: float
     offset: float
     law: str
@@ -194,7 +194,7 @@ class _Reader:
     def rates(self) -> dict:
         """Every state's right-hand side (bristle states excluded), signals resolved."""
         out = {s: self.expr(self.spec.equations[s]) for s in self.spec.states}
-        for out_name, (b, a, c, D, names) in self.blocks.items():
+        for b, a, _, _, names in self.blocks.values():
             for i in range(len(names) - 1):
                 out[names[i]] = self.xsym[names[i + 1]]
             if names:
@@ -244,7 +244,7 @@ class _Reader:
         mass, cm, b_extra, offset = self.plant(v, c, drive)
         law, curve, s0, s1 = self.friction(c, b_extra)
         ctrl = None
-        if drive is not None and drive not in spec.parameters:
+        if drive not in spec.parameters:
             ctrl = self.controller(drive, q, v, c)
         return MechanicalParameters(q, v, mass, drive, cm, offset, law, curve, s0, s1, ctrl)
 
@@ -490,7 +490,9 @@ def _polish(J, gains) -> tuple:
 
 @dataclass(frozen=True)
 class _Linear:
-    """A linear controller x' = A x + Bq q + Bv v + E r, u = C x + Dq q + Dv v + F r (arrays)."""
+    """A linear controller x' = A x + Bq q + Bv v, u = C x + Dq q + Dv v (arrays), whose transfer
+    functions from q (with v = s q) and from an input entering the rates through E and the
+    output through F are evaluated on a grid of s."""
 
     A: np.ndarray
     Bq: np.ndarray

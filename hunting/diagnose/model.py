@@ -1,6 +1,6 @@
 """The nominal model a diagnosis starts from: plant, friction law, controller, read from the
-MODEL.json schema of ``hunting diagnose`` (or a preset), with the static friction map the force
-residual needs.
+MODEL.json schema of ``hunting diagnose`` (or a preset, or a model description through
+:mod:`hunting.diagnose.from_description`), with the static friction map the force residual needs.
 
 Schema (keys beyond these are errors, so typos are caught):
 
@@ -55,6 +55,16 @@ errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(
                 the measured q (a note above 10 % RMS mismatch).
   "sensor":     {"resolution": m, "noise": m}  (encoder step; noise before quantization)
   or a preset:  {"preset": "table9.1", "set": {"P": 60.0}}  (see: hunting models)
+
+  or a model description (the equations format of 'hunting simulate --model', JSON or YAML), read
+  exactly or refused with one line naming the part: one friction contact whose velocity is a state
+  v, a state q with q' = v, m v' = cm u - F - b v - offset (constant coefficients; u the data's u);
+  friction 'switch' with slip = Fc + (Fs - Fc) exp(-(|w|/vs)^beta) + b|w| per direction and stick
+  = Fs, or 'lugre' with constant sigma0, sigma1, a Stribeck level and viscous b*w; u a PID
+  -(kp + ki/s + kd s/(tau_f s + 1)) of q from signals or transfer-function blocks, the reference
+  r (a parameter or signal of t, replaced by the data's q_ref) in every term (derivative on the
+  error) or in P and I only (on the measurement), or u a parameter (no controller). Example:
+  examples/pd_servo.json in a checkout.
 
 Example (examples/emps/model.json, the EMPS benchmark's published model):
   {"plant": {"mass": 95.1089, "motor_constant": 35.15065188},
