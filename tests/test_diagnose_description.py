@@ -173,3 +173,20 @@ def test_an_open_loop_description_has_no_controller_and_its_gain_is_read():
     d = _variant(parameters={"m": 95.0, "cm": 35.15, "Fc": 20.0, "b": 200.0, "u": 0.0}, signals={})
     model = nominal_from_description(d)
     assert model.controller is None and model.cm == 35.15 and model.mass == 95.0
+
+
+@pytest.mark.parametrize("u, on", [("-kp*(q - r) - kd*(v - 0.1*cos(t)) - ki*xi", "error"),
+                                   ("-kp*(q - r) - kd*v - ki*xi", "measurement"),
+                                   ("-kp*(q - r) - kd*(v - 0.2*cos(t)) - ki*xi", None)])
+def test_where_the_derivative_acts_is_read_from_a_reference_signal_of_t(u, on):
+    """r = 0.1 sin t: kd (v - r') is the derivative on the error, kd v on the measurement, and a
+    wrong r' (0.2 cos t) is neither: refused, naming the terms."""
+    d = _variant(parameters={"m": 1.0, "cm": 1.0, "Fc": 0.5, "b": 0.1, "kp": 50.0, "kd": 5.0, "ki": 20.0},
+                 states=["q", "v", "xi"], equations={"q": "v", "v": "(cm*u - F)/m", "xi": "q - r"},
+                 signals={"r": "0.1*sin(t)", "u": u})
+    if on is None:
+        with pytest.raises(SystemDefinitionError, match="are not one reference r entering as the error"):
+            nominal_from_description(d)
+        return
+    c = nominal_from_description(d).controller
+    assert (c["kp"], c["kd"], c["ki"], c.get("derivative_on", "error")) == (50.0, 5.0, 20.0, on)

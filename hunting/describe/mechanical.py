@@ -369,11 +369,12 @@ class _Reader:
         spec = self.spec
         where = f"{'signals' if drive in spec.signals else 'blocks'}[{drive!r}]"
         # signals of t and parameters only stay names: candidates for the reference
-        self.keep = set()
+        self.keep, self.time_signals = set(), {}
         for k in spec.signals:
             e = self.resolve(k)
             if e.has(self.t) and not (e.free_symbols - {self.t} - set(self.psym.values())):
                 self.keep.add(k)
+                self.time_signals[k] = e
         u = self.resolve(drive)
         rates = self.rates()
         self.keep = set()
@@ -431,10 +432,15 @@ class _Reader:
             coef = [sp.diff(e, R) for e in exo]
             if not all(self.is_constant(k) and not k.has(R) for k in coef):
                 continue
-            if any(sp.simplify((e - k * R).subs(self.pval)) != 0 for e, k in zip(exo, coef)):
+            # a signal r(t) may also enter through its derivative r'(t) (written out, e.g. kd*(v - r'))
+            dr = sp.diff(self.time_signals[r], self.t) if r in self.time_signals else sp.Integer(0)
+            rest = [sp.simplify((e - k * R).subs(self.pval)) for e, k in zip(exo, coef)]
+            kd_r = [sp.simplify(x / dr) if dr != 0 else sp.Integer(0) for x in rest]
+            if any(x != 0 and (dr == 0 or not self.is_constant(y) or y.has(self.t)) for x, y in zip(rest, kd_r)):
                 continue
             k = np.array([self.number(k) for k in coef])
-            g = lin.from_input(s_grid, k[1:], k[0])
+            k1 = np.array([self.number(y) for y in kd_r])
+            g = lin.from_input(s_grid, k[1:] + 0j, k[0]) + s_grid * lin.from_input(s_grid, k1[1:] + 0j, k1[0])
             if np.max(np.abs(g + h) / scale) < CONTROLLER_TOLERANCE:
                 found.append((r, "error"))
             elif np.max(np.abs(g - (kp + ki / s_grid)) / scale) < CONTROLLER_TOLERANCE:
@@ -514,7 +520,7 @@ class _Linear:
 
     def from_input(self, s_grid, E, F) -> np.ndarray:
         """u per r at each s for the input vectors E (states) and F (output)."""
-        return np.array([self._through(s, E.astype(complex)) + F for s in s_grid])
+        return np.array([self._through(s, E) + F for s in s_grid])
 
 
 # ---------------------------------------------------------------------- readings
