@@ -25,19 +25,21 @@ PD_JSON = {"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 0.0},
            "controller": {"type": "pid", "kp": 38880.0, "kd": 243.0, "ki": 0.0, "derivative_on": "measurement"}}
 PD_DESCRIPTION = json.loads((ROOT / "examples" / "pd_servo.json").read_text())    # README's example
 
-# Direction-dependent Stribeck levels, an offset, a viscous term written in the equation, and a
-# PID with a filtered derivative on the error as one transfer-function block.
-STRIBECK_JSON = {"plant": {"mass": 2.0, "motor_constant": 1.5, "offset": 0.3},
+# Direction-dependent Stribeck levels, an offset, two cogging harmonics, a viscous term written in
+# the equation, and a PID with a filtered derivative on the error as one transfer-function block.
+STRIBECK_JSON = {"plant": {"mass": 2.0, "motor_constant": 1.5, "offset": 0.3,
+                           "cogging": [{"pitch": 0.02, "cos": [0.3, 0.1], "sin": [0.2, 0.0]}]},
                  "friction": {"law": "switch", "Fc": 1.0, "Fs": 1.4, "vs": 0.01, "beta": 1.5, "b": 0.5,
                               "Fc_neg": 0.8, "Fs_neg": 1.2, "vs_neg": 0.02, "beta_neg": 2.0, "b_neg": 0.4},
                  "controller": {"type": "pid", "kp": 200.0, "kd": 10.0, "ki": 50.0, "tau_f": 0.002}}
 STRIBECK_DESCRIPTION = {
     "parameters": {"m": 2.0, "cm": 1.5, "F0": 0.3, "bq": 0.1, "r": 0.0, "kp": 200.0, "ki": 50.0, "kd": 10.0,
                    "tau_f": 0.002, "Fc": 1.0, "Fs": 1.4, "vs": 0.01, "beta": 1.5, "b": 0.4,
-                   "Fc_neg": 0.8, "Fs_neg": 1.2, "vs_neg": 0.02, "b_neg": 0.3},
+                   "Fc_neg": 0.8, "Fs_neg": 1.2, "vs_neg": 0.02, "b_neg": 0.3, "p": 0.02},
     "states": ["q", "v"],
+    "signals": {"F_cog": "0.3*cos(2*pi*q/p) + 0.2*sin(2*pi*q/p) + 0.1*cos(4*pi*q/p)"},
     "blocks": [{"output": "u", "input": "r - q", "tf": "kp + ki/s + kd*s/(tau_f*s + 1)"}],
-    "equations": {"q": "v", "v": "(cm*u - F - bq*v - F0)/m"},
+    "equations": {"q": "v", "v": "(cm*u - F - bq*v - F0 - F_cog)/m"},
     "friction": {"force": "F", "velocity": "v", "model": "switch",
                  "slip": "(1 + sign(w))/2*(Fc + (Fs - Fc)*exp(-(abs(w)/vs)**beta) + b*w)"
                          " + (1 - sign(w))/2*(-Fc_neg - (Fs_neg - Fc_neg)*exp(-(w/vs_neg)**2) + b_neg*w)",
@@ -80,6 +82,16 @@ def test_the_presets_written_as_descriptions_map_to_the_preset_nominal_models(na
     x1 = q - q_d: PDI and fixed-shape PIDs, Stribeck exponent 2, LuGre) against the preset path."""
     from hunting.models import preset_description
     _same(nominal_from_description(preset_description(name)), NominalModel.from_dict({"preset": name}))
+
+
+@pytest.mark.parametrize("name", ["limms-switch", "limms-lugre"])
+def test_cogging_harmonics_are_read_off_the_velocity_equation(name):
+    """Chapter 10's motor: F_cog = A sin(2 pi (x1 + q_d)/pitch + phase) in the description's
+    position state x1 = q - q_d. The description's position state is the data's q, so the two
+    agree where the frames do (q_d = 0): every field equal, the cogging component too."""
+    from hunting.models import preset_description
+    _same(nominal_from_description(preset_description(name, q_d=0.0)),
+          NominalModel.from_dict({"preset": name, "set": {"q_d": 0.0}}))
 
 
 def test_diagnose_gives_the_same_report_with_the_description_or_the_json(tmp_path):
@@ -132,7 +144,9 @@ UNMAPPABLE = [
     (_variant(friction__slip="sign(w)*(Fc + 5*exp(-(w/0.01)**2)*(1 + 0.01*abs(w))) + b*w",
               friction__stick="Fc + 5"), "the positive-direction force is not of the Stribeck form"),
     (_variant(friction__stick="1.2*Fc"), "friction['friction'].stick: the positive-direction stick bound is 24"),
-    (_variant(equations={"q": "v", "v": "(cm*u - F - 3*sin(q))/m"}), "has a term in ['q']"),
+    (_variant(equations={"q": "v", "v": "(cm*u - F - 3*tanh(q/0.01))/m"}), "has a term in ['q']"),
+    (_variant(equations={"q": "v", "v": "(cm*u - F - 3*sin(q/0.01) - sin(sqrt(2)*q/0.01))/m"}),
+     "not harmonics of one pitch"),
     (_variant(signals={"u": "min(kv*(kp*(q_ref - q) - v), 10)"}), "signals['u']: the controller is not linear"),
     (_variant(signals={"u": "kv*(kp*(q_ref - q) - v) + 2"}), "are not one reference r"),
 ]
@@ -140,7 +154,8 @@ UNMAPPABLE = [
 
 @pytest.mark.parametrize("description, expected", UNMAPPABLE,
                          ids=["rational-law", "moving-belt", "two-contacts", "loop-shaped", "lead-lag",
-                              "near-stribeck", "stick-above-Fs", "position-force", "saturation", "feedforward"])
+                              "near-stribeck", "stick-above-Fs", "position-force", "incommensurate-cogging",
+                              "saturation", "feedforward"])
 def test_a_description_without_a_reading_is_one_line_and_exit_2(tmp_path, capsys, description, expected):
     data = tmp_path / "d.csv"
     data.write_text("t,q,u\n0,0,0\n0.001,0,0\n")

@@ -1,7 +1,7 @@
 """Physical parameters read off a model description: one mechanical degree of freedom with one
 friction contact, the motor constant, a Stribeck (or LuGre) friction law and a PID controller.
 
-The description says ``m v' = cm u - F - b v - offset`` in whatever algebra the user wrote;
+The description says ``m v' = cm u - F - b v - offset - F_cog(q)`` in whatever algebra the user wrote;
 this module reads the numbers back from the description's own symbolic form (the parsed
 expressions and the linear blocks, through sympy; no text is re-parsed or evaluated) and checks
 each reading numerically. What cannot be read exactly is a :class:`~hunting.errors.SystemDefinitionError`
@@ -10,7 +10,8 @@ naming the key and what is allowed, never an approximation:
 - the plant: the contact's velocity is a state ``v`` (no moving belt), one state ``q`` has
   ``q' = v``, and the equation of ``v`` is affine in the friction force ``F``, the drive ``u``
   and ``v`` with constant coefficients: ``m = -1 / (dv'/dF)``, ``cm = m dv'/du``, a viscous term
-  ``b = -m dv'/dv`` (added to the friction law's) and a constant rest (``offset = -m rest``);
+  ``b = -m dv'/dv`` (added to the friction law's), a constant rest (``offset = -m rest``) and
+  sines and cosines of ``w q + phi`` (cogging ``F_cog(q)``, harmonics of the smallest ``w``);
 - the friction law: a ``switch`` slip force equal, per direction, to ``Fc + (Fs - Fc)
   exp(-(|w|/vs)^beta) + b |w|`` (read off and compared on a dense velocity grid: relative error
   below :data:`LAW_TOLERANCE`) with a stick bound equal to ``Fs``; or ``lugre`` with constant
@@ -34,6 +35,7 @@ import numpy as np
 
 from ..errors import SystemDefinitionError
 from ..models.friction import DirectionalCurve, StribeckCurve
+from ..models.plant import Cogging
 from .description import SLIP_VARIABLE, ContactSpec, Spec, validate
 from .expressions import TIME, to_sympy
 
@@ -73,7 +75,8 @@ class MechanicalParameters:
     offset [N] : constant force in m v' = cm u - F(v) - offset; law : "switch" or "lugre"; curve :
     the friction's :class:`DirectionalCurve` (viscous terms of the equation included in its b);
     sigma0 [N/m], sigma1 [N s/m] : LuGre's (None for switch); controller : a :class:`PIDReading`
-    when the drive is a signal, None when it is a parameter (an open loop)."""
+    when the drive is a signal, None when it is a parameter (an open loop); cogging : F_cog(q) as a
+    harmonic :class:`Cogging` (m v' = cm u - F - offset - F_cog), or None."""
 
     position: str
     velocity: str
@@ -86,6 +89,7 @@ class MechanicalParameters:
     sigma0: float | None = None
     sigma1: float | None = None
     controller: PIDReading | None = None
+    cogging: Cogging | None = None
 
 
 def mechanical_parameters(description, **overrides) -> MechanicalParameters:
@@ -241,12 +245,12 @@ class _Reader:
                     f"equations[{s!r}] uses the friction force {c.force!r}: a diagnosable model has one mechanical "
                     f"degree of freedom (q, {v}); a second mass or a flexible load has no reading")
         drive = self.drive(v)
-        mass, cm, b_extra, offset = self.plant(v, c, drive)
+        mass, cm, b_extra, offset, cog = self.plant(q, v, c, drive)
         law, curve, s0, s1 = self.friction(c, b_extra)
         ctrl = None
         if drive not in spec.parameters:
             ctrl = self.controller(drive, q, v, c)
-        return MechanicalParameters(q, v, mass, drive, cm, offset, law, curve, s0, s1, ctrl)
+        return MechanicalParameters(q, v, mass, drive, cm, offset, law, curve, s0, s1, ctrl, cog)
 
     def drive(self, v) -> str | None:
         """The name the motor constant multiplies: 'u' when a signal, block output or parameter
@@ -269,7 +273,7 @@ class _Reader:
                 f"the plant {DRIVE!r} (the data's u column)")
         return None
 
-    def plant(self, v, c: ContactSpec, drive):
+    def plant(self, q, v, c: ContactSpec, drive):
         sp = self.sp
         self.keep = {drive} if drive is not None else set()
         e = self.expr(self.spec.equations[v])
@@ -289,17 +293,19 @@ class _Reader:
                     f"{c.force} - b {v} - offset with constant m, cm, b, offset")
             coef[name], dsym[name] = self.number(d), d
         rest = sp.expand(e - sp.diff(e, F) * F - sp.diff(e, U) * U - sp.diff(e, V) * V)
-        if not self.is_constant(rest):
-            used = sorted(map(str, rest.free_symbols - set(self.psym.values())))
-            raise SystemDefinitionError(
-                f"{where} has a term in {used} beside the drive, the friction force and {v}: allowed m {v}' = cm u - "
-                f"{c.force} - b {v} - offset (position-dependent, time-dependent or state-feedback forces have no "
-                "reading: write a controller as the signal u)")
         aF = coef[c.force]
         if not aF < 0:
             raise SystemDefinitionError(
                 f"{where}: d{v}'/d{c.force} = {aF:g} must be negative (the friction force opposes the motion: "
                 f"m {v}' = ... - {c.force})")
+        harmonic, rest = self.cogging(rest, q, where, -1 / dsym[c.force])
+        if not self.is_constant(rest):
+            used = sorted(map(str, rest.free_symbols - set(self.psym.values())))
+            raise SystemDefinitionError(
+                f"{where} has a term in {used} beside the drive, the friction force and {v}: allowed m {v}' = cm u - "
+                f"{c.force} - b {v} - offset - F_cog({q}), F_cog a sum of sin and cos of 2 pi k {q} / pitch + phase "
+                "(time-dependent, state-feedback and other position-dependent forces have no reading: write a "
+                "controller as the signal u)")
         mass = self.exact(-1 / dsym[c.force])
         if drive is None:
             raise SystemDefinitionError(
@@ -310,7 +316,61 @@ class _Reader:
             raise SystemDefinitionError(
                 f"{where}: the motor constant (m d{v}'/d{drive}) is {cm:g}; it must be > 0 (flip the sign of "
                 f"{drive!r} and of its controller)")
-        return mass, cm, self.exact(dsym[v] / dsym[c.force]) + 0.0, self.exact(rest / dsym[c.force]) + 0.0
+        cog = None if harmonic is None else Cogging.harmonic(*harmonic)
+        return mass, cm, self.exact(dsym[v] / dsym[c.force]) + 0.0, self.exact(rest / dsym[c.force]) + 0.0, cog
+
+    def cogging(self, rest, q, where, mass):
+        """(harmonic, constant): the force -mass * (the part of ``rest``, a sympy expression, that
+        is a sum of c sin(w q + phi) and c cos(w q + phi) with constant c, w, phi) as (pitch, cos,
+        sin) coefficients [N] of the harmonics k = 1, 2, .. of the smallest w (None when there is
+        none), and what is left of ``rest``. ``mass`` is a sympy expression (the coefficients are
+        computed at 50 digits); the harmonics are checked against ``rest`` on a grid of q."""
+        sp = self.sp
+        Q = self.xsym[q]
+        atoms = [a for a in rest.atoms(sp.sin, sp.cos) if a.has(Q)]
+        if not atoms:
+            return None, rest
+        terms = []                                      # (omega, phase, coefficient, is_sin)
+        A = [sp.Dummy() for _ in atoms]
+        lin = rest.xreplace(dict(zip(atoms, A)))
+        for atom, a in zip(atoms, A):
+            arg = atom.args[0]
+            w, coef = sp.diff(arg, Q), sp.diff(lin, a)
+            if not (self.is_constant(w) and self.is_constant(coef) and not (arg - w * Q).has(Q)):
+                return None, rest                       # not a harmonic: the caller names the term
+            terms.append((self.number(w), self.number(arg - w * Q), self.exact(-mass * coef), atom.func == sp.sin, w))
+        left = lin.xreplace({a: 0 for a in A})
+        if left.has(Q):
+            return None, rest
+        w0 = min(abs(t[0]) for t in terms)
+        n = 0
+        for w, *_ in terms:
+            k = abs(w) / w0
+            if abs(k - round(k)) > 1e-9 or round(k) > 64:
+                raise SystemDefinitionError(
+                    f"{where}: the position-dependent force has frequencies {sorted({abs(t[0]) for t in terms})} "
+                    f"rad per unit of {q}, not harmonics of one pitch (allowed: F_cog a sum of sin and cos of 2 pi k "
+                    f"{q} / pitch + phase, k = 1, 2, ..)")
+            n = max(n, round(k))
+        cos, sin = [0.0] * n, [0.0] * n
+        for w, phi, c, is_sin, _ in terms:
+            k, sg = round(abs(w) / w0) - 1, (1.0 if w > 0 else -1.0)
+            if is_sin:      # c sin(w q + phi) = c cos(phi) sin(w q) + c sin(phi) cos(w q)
+                sin[k] += c * math.cos(phi) * sg
+                cos[k] += c * math.sin(phi)
+            else:           # c cos(w q + phi) = c cos(phi) cos(w q) - c sin(phi) sin(w q)
+                cos[k] += c * math.cos(phi)
+                sin[k] -= c * math.sin(phi) * sg
+        pitch = self.exact(2 * sp.pi / sp.Abs(min(terms, key=lambda t: abs(t[0]))[4]))
+        qs = np.linspace(-2 * pitch, 2 * pitch, 4001)
+        f = sp.lambdify(Q, (-mass * (rest - left)).subs(self.pval), "numpy")
+        got = np.asarray(f(qs), dtype=float) * np.ones_like(qs)
+        mine = Cogging.harmonic(pitch, cos, sin)(qs)
+        scale = max(float(np.max(np.abs(got))), 1e-300)
+        if float(np.max(np.abs(got - mine))) > 1e-9 * scale:
+            raise SystemDefinitionError(f"{where}: the position-dependent force is not read exactly as harmonics "
+                                        f"(deviation {np.max(np.abs(got - mine)) / scale:.3g} of its size)")
+        return (pitch, cos, sin), left
 
     # ------------------------------------------------------------------ friction
     def law(self, e, c: ContactSpec):

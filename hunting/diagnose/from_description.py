@@ -11,9 +11,11 @@ error naming the part that has none; this module assembles the :class:`NominalMo
   ``"derivative_on": "measurement"`` when the reference enters the P and I terms only; the data's
   ``q_ref`` column is the reference (the description's reference parameter or signal is only its
   placeholder) and the controller is updated every data sample (a description is continuous);
-- what a description cannot say stays at the nominal model's defaults: no delay, cogging,
-  flexibility, frictional lag or dwell, saturation or sample time, and the sensor's resolution
-  read from the data.
+- cogging: the harmonics read off the velocity equation, as functions of the description's
+  position state (which is the data's q column);
+- what a description cannot say stays at the nominal model's defaults: no delay, flexibility,
+  frictional lag or dwell, saturation or sample time, and the sensor's resolution read from the
+  data.
 """
 from __future__ import annotations
 
@@ -77,5 +79,5 @@ def nominal_from_parameters(p: MechanicalParameters) -> NominalModel:
         if c.derivative_on != "error":
             ctrl["derivative_on"] = c.derivative_on
     model = NominalModel(p.mass, p.cm, p.curve, law, offset=p.offset, sigma0=p.sigma0, sigma1=p.sigma1,
-                         controller=ctrl)
+                         controller=ctrl, cogging=() if p.cogging is None else (p.cogging,))
     return model.replace()

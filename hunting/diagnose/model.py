@@ -58,7 +58,8 @@ errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(
 
   or a model description (the equations format of 'hunting simulate --model', JSON or YAML), read
   exactly or refused with one line naming the part: one friction contact whose velocity is a state
-  v, a state q with q' = v, m v' = cm u - F - b v - offset (constant coefficients; u the data's u);
+  v, a state q with q' = v, m v' = cm u - F - b v - offset - F_cog(q) (constant coefficients; u
+  the data's u; F_cog sines and cosines of 2 pi k q / pitch + phase: the plant's cogging);
   friction 'switch' with slip = Fc + (Fs - Fc) exp(-(|w|/vs)^beta) + b|w| per direction and stick
   = Fs, or 'lugre' with constant sigma0, sigma1, a Stribeck level and viscous b*w; u a PID
   -(kp + ki/s + kd s/(tau_f s + 1)) of q from signals or transfer-function blocks, the reference
