@@ -148,6 +148,7 @@ UNMAPPABLE = [
     (_variant(equations={"q": "v", "v": "(cm*u - F - 3*sin(q/0.01) - sin(sqrt(2)*q/0.01))/m"}),
      "not harmonics of one pitch"),
     (_variant(signals={"u": "min(kv*(kp*(q_ref - q) - v), 10)"}), "signals['u']: the controller is not linear"),
+    (_variant(signals={"u": "min(max(kv*(kp*(q_ref - q) - v), -5), 10)"}), "allowed a symmetric saturation"),
     (_variant(signals={"u": "kv*(kp*(q_ref - q) - v) + 2"}), "are not one reference r"),
 ]
 
@@ -155,7 +156,7 @@ UNMAPPABLE = [
 @pytest.mark.parametrize("description, expected", UNMAPPABLE,
                          ids=["rational-law", "moving-belt", "two-contacts", "loop-shaped", "lead-lag",
                               "near-stribeck", "stick-above-Fs", "position-force", "incommensurate-cogging",
-                              "saturation", "feedforward"])
+                              "one-sided-limit", "asymmetric-saturation", "feedforward"])
 def test_a_description_without_a_reading_is_one_line_and_exit_2(tmp_path, capsys, description, expected):
     data = tmp_path / "d.csv"
     data.write_text("t,q,u\n0,0,0\n0.001,0,0\n")
@@ -181,6 +182,15 @@ def test_docstring_examples():
     for mod in (mechanical, from_description):
         res = doctest.testmod(mod)
         assert res.failed == 0 and res.attempted > 0
+
+
+def test_a_symmetric_saturation_is_the_controller_saturation():
+    """The synthetic servo's 10 V limit written as min(max(u, -10), 10), either nesting."""
+    for u in ("min(max(kv*(kp*(q_ref - q) - v), -umax), umax)", "max(-umax, min(umax, kv*(kp*(q_ref - q) - v)))"):
+        d = _variant(signals={"u": u})
+        d["parameters"]["umax"] = 10.0
+        _same(nominal_from_description(d), NominalModel.from_dict(
+            {**PD_JSON, "controller": {**PD_JSON["controller"], "saturation": 10.0}}))
 
 
 def test_an_open_loop_description_has_no_controller_and_its_gain_is_read():

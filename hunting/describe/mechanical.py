@@ -16,7 +16,8 @@ naming the key and what is allowed, never an approximation:
   exp(-(|w|/vs)^beta) + b |w|`` (read off and compared on a dense velocity grid: relative error
   below :data:`LAW_TOLERANCE`) with a stick bound equal to ``Fs``; or ``lugre`` with constant
   sigma0 and sigma1, a Stribeck ``level`` and a linear ``viscous`` term;
-- the controller: the drive ``u`` (a signal or block output) is a linear time-invariant function
+- the controller: the drive ``u`` (a signal or block output, optionally limited as
+  ``min(max(.., -S), S)``) is a linear time-invariant function
   of q, v and controller states whose transfer function from q is a PID ``-(kp + ki/s + kd s /
   (tau_f s + 1))`` (checked on a frequency grid to :data:`CONTROLLER_TOLERANCE`), the reference
   entering through one name (a parameter or a signal of t) either as the error ``q - r`` in every
@@ -56,7 +57,8 @@ class PIDReading:
 
     kp [u/m], ki [u/(m s)], kd [u s/m], tau_f [s] (0: no filter); reference : the name through
     which r enters (a parameter or a signal of t), or None when the description regulates q to 0
-    (then the description does not say where the derivative acts and "error" is reported)."""
+    (then the description does not say where the derivative acts and "error" is reported);
+    saturation : the bound S of u = min(max(PID, -S), S) (inf: none)."""
 
     kp: float
     ki: float
@@ -64,6 +66,7 @@ class PIDReading:
     tau_f: float = 0.0
     derivative_on: str = "error"
     reference: str | None = None
+    saturation: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -435,7 +438,7 @@ class _Reader:
             if e.has(self.t) and not (e.free_symbols - {self.t} - set(self.psym.values())):
                 self.keep.add(k)
                 self.time_signals[k] = e
-        u = self.resolve(drive)
+        u, saturation = self.saturation(self.resolve(drive), where)
         rates = self.rates()
         self.keep = set()
         cstates = [s for s in list(spec.states) + [n for *_, names in self.blocks.values() for n in names]
@@ -475,7 +478,27 @@ class _Reader:
                 "no reading")
         gains = _polish(J.subs(self.pval).evalf(50), gains)
         ref, on = self.reference(exo, where, lin, s_grid, h, gains)
-        return PIDReading(*gains, on, ref)
+        return PIDReading(*gains, on, ref, saturation)
+
+    def saturation(self, u, where):
+        """(inner, bound): u = min(max(inner, -S), S) (either nesting) gives (inner, S) with S a
+        constant > 0; any other u gives (u, inf)."""
+        sp = self.sp
+        for outer, inner_f, sign in ((sp.Min, sp.Max, 1), (sp.Max, sp.Min, -1)):
+            if u.func is outer and len(u.args) == 2:
+                const = [a for a in u.args if self.is_constant(a)]
+                nested = [a for a in u.args if a.func is inner_f and len(a.args) == 2]
+                if len(const) == 1 and len(nested) == 1:
+                    lo = [a for a in nested[0].args if self.is_constant(a)]
+                    rest = [a for a in nested[0].args if not self.is_constant(a)]
+                    if len(lo) == 1 and len(rest) == 1:
+                        hi_v, lo_v = sign * self.exact(const[0]), -sign * self.exact(lo[0])
+                        if not (hi_v > 0 and hi_v == lo_v):
+                            raise SystemDefinitionError(
+                                f"{where}: the controller output is limited to [{-lo_v:g}, {hi_v:g}]: allowed a "
+                                "symmetric saturation min(max(u, -S), S) with S > 0")
+                        return rest[0], hi_v
+        return u, math.inf
 
     def reference(self, exo, where, lin, s_grid, h, gains):
         """(name, derivative_on) of the reference: the terms without states must be linear in one
@@ -621,7 +644,6 @@ def _stribeck(e_sym, x, values, where, side, stick, stick_where) -> StribeckCurv
     if stribeck:
         with np.errstate(all="ignore"):
             d = (y - b * xs - Fc) / drop                # exp(-(x/vs)^beta) if of the Stribeck form
-            z = np.log(-np.log(d))                      # beta (log x - log vs)
         ok = (d > 0.05) & (d < 0.95)
         if ok.sum() >= 2:
             # two speeds where the dip is well conditioned, the law evaluated there at 50 digits:

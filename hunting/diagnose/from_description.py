@@ -10,15 +10,16 @@ error naming the part that has none; this module assembles the :class:`NominalMo
 - controller: ``{"type": "pid", "kp", "kd", "ki"}`` with ``"tau_f"`` for a derivative filter and
   ``"derivative_on": "measurement"`` when the reference enters the P and I terms only; the data's
   ``q_ref`` column is the reference (the description's reference parameter or signal is only its
-  placeholder) and the controller is updated every data sample (a description is continuous);
+  placeholder), ``"saturation"`` for a ``min(max(.., -S), S)`` limit, and the controller is
+  updated every data sample (a description is continuous);
 - cogging: the harmonics read off the velocity equation, as functions of the description's
   position state (which is the data's q column);
 - what a description cannot say stays at the nominal model's defaults: no delay, flexibility,
-  frictional lag or dwell, saturation or sample time, and the sensor's resolution read from the
-  data.
+  frictional lag or dwell, sample time, and the sensor's resolution read from the data.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from ..describe.mechanical import MechanicalParameters, mechanical_parameters
@@ -78,6 +79,8 @@ def nominal_from_parameters(p: MechanicalParameters) -> NominalModel:
             ctrl["tau_f"] = c.tau_f
         if c.derivative_on != "error":
             ctrl["derivative_on"] = c.derivative_on
+        if math.isfinite(c.saturation):
+            ctrl["saturation"] = c.saturation
     model = NominalModel(p.mass, p.cm, p.curve, law, offset=p.offset, sigma0=p.sigma0, sigma1=p.sigma1,
                          controller=ctrl, cogging=() if p.cogging is None else (p.cogging,))
     return model.replace()

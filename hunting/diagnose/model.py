@@ -64,7 +64,8 @@ errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(
   = Fs, or 'lugre' with constant sigma0, sigma1, a Stribeck level and viscous b*w; u a PID
   -(kp + ki/s + kd s/(tau_f s + 1)) of q from signals or transfer-function blocks, the reference
   r (a parameter or signal of t, replaced by the data's q_ref) in every term (derivative on the
-  error) or in P and I only (on the measurement), or u a parameter (no controller). Example:
+  error) or in P and I only (on the measurement), optionally min(max(PID, -S), S) (saturation
+  S), or u a parameter (no controller). Example:
   examples/pd_servo.json in a checkout.
 
 Example (examples/emps/model.json, the EMPS benchmark's published model):
