@@ -142,23 +142,24 @@ def test_diagnose_failures_inside_the_command_are_one_line(capsys, files):
 
 
 def test_diagnose_bad_inputs_name_what_is_wrong(capsys, files):
-    """Exit 2 and the diagnosis' own words: a dropped required column, a ragged row, and a model
-    description (the equations format of simulate --model) where diagnose's nominal model JSON
-    belongs (it once said "Expecting value: line 1 column 1")."""
+    """Exit 2 and the diagnosis' own words: a dropped required column, a ragged row, and model
+    descriptions (the equations format of simulate --model) that have no nominal-model reading (a
+    moving belt; a loop-shaped controller): the part that cannot be read is named (the YAML one
+    once said "Expecting value: line 1 column 1"). tests/test_diagnose_description.py has more."""
     (files / "model.json").write_text(json.dumps({"plant": {"mass": 95.0, "motor_constant": 35.15},
                                                   "friction": {"law": "coulomb-viscous", "Fc": 20.0, "b": 200.0}}))
     (files / "ragged.csv").write_text("t,q,u\n0,0,0\n0.001,0\n0.002,0,0,5\n")
     cases = [(f"diagnose {files}/data.csv --model {files}/model.json --drop u", "column 'u' cannot be left out"),
              (f"diagnose {files}/ragged.csv --model {files}/model.json", "line 3 has 2 fields, the header has 3"),
-             (f"diagnose {files}/data.csv --model {ROOT}/examples/belt.json", "is a model description"),
-             (f"diagnose {files}/data.csv --model {ROOT}/examples/loopshaped.yaml", "is a model description"),
+             (f"diagnose {files}/data.csv --model {ROOT}/examples/belt.json", "'v - vb' is not a velocity state"),
+             (f"diagnose {files}/data.csv --model {ROOT}/examples/loopshaped.yaml", "is not a PID"),
              (f"diagnose {files}/data.csv --model {files}/data.csv", "is not JSON")]
     for argv, expected in cases:
         code, _, err = run_main(capsys, argv.split())
         line = one_line_error(err)
         assert code == 2 and expected in line, (argv, code, line)
-        if "description" in expected:
-            assert "Expecting value" not in line and "examples/emps/model.json" in line
+        if "examples/" in argv:
+            assert "Expecting value" not in line and line.startswith("hunting: error: model description ")
 
 
 def test_at_least_forty_bad_inputs_are_covered():

@@ -36,7 +36,8 @@ def add_arguments(p) -> None:
 
     p.format_help = with_schema
     p.add_argument("data", help="measured data (CSV, .npz or .mat; columns below)")
-    p.add_argument("--model", required=True, help="the nominal model as JSON (format below)")
+    p.add_argument("--model", required=True, help="the nominal model: its JSON, or a model description (the "
+                   "equations format of simulate --model, JSON or YAML); both below")
     p.add_argument("--validate", help="validation data (default: the last 40 %% of DATA)")
     p.add_argument("--names", help="column names in the files, e.g. q=qm,u=vir")
     p.add_argument("--drop", action="append", help="leave this optional column out (e.g. u_inj)")

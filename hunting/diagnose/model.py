@@ -1,6 +1,6 @@
 """The nominal model a diagnosis starts from: plant, friction law, controller, read from the
-MODEL.json schema of ``hunting diagnose`` (or a preset), with the static friction map the force
-residual needs.
+MODEL.json schema of ``hunting diagnose`` (or a preset, or a model description through
+:mod:`hunting.diagnose.from_description`), with the static friction map the force residual needs.
 
 Schema (keys beyond these are errors, so typos are caught):
 
@@ -55,6 +55,18 @@ errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(
                 the measured q (a note above 10 % RMS mismatch).
   "sensor":     {"resolution": m, "noise": m}  (encoder step; noise before quantization)
   or a preset:  {"preset": "table9.1", "set": {"P": 60.0}}  (see: hunting models)
+
+  or a model description (the equations format of 'hunting simulate --model', JSON or YAML), read
+  exactly or refused with one line naming the part: one friction contact whose velocity is a state
+  v, a state q with q' = v, m v' = cm u - F - b v - offset - F_cog(q) (constant coefficients; u
+  the data's u; F_cog sines and cosines of 2 pi k q / pitch + phase: the plant's cogging);
+  friction 'switch' with slip = Fc + (Fs - Fc) exp(-(|w|/vs)^beta) + b|w| per direction and stick
+  = Fs, or 'lugre' with constant sigma0, sigma1, a Stribeck level and viscous b*w; u a PID
+  -(kp + ki/s + kd s/(tau_f s + 1)) of q from signals or transfer-function blocks, the reference
+  r (a parameter or signal of t, replaced by the data's q_ref) in every term (derivative on the
+  error) or in P and I only (on the measurement), optionally min(max(PID, -S), S) (saturation
+  S), or u a parameter (no controller). Example:
+  examples/pd_servo.json in a checkout.
 
 Example (examples/emps/model.json, the EMPS benchmark's published model):
   {"plant": {"mass": 95.1089, "motor_constant": 35.15065188},
@@ -125,13 +137,9 @@ def highpass_response(a: np.ndarray, dt: float, frequency: float, damping: float
 
 
 _NOMINAL_KEYS = {"preset", "set", "plant", "friction", "controller", "sensor"}
-# the keys of a model description (hunting.describe: states and equations), which diagnose cannot
-# map onto its fixed plant + friction law + controller structure
+# the keys of a model description (hunting.describe: states and equations), read by
+# from_description.nominal_from_description
 _DESCRIPTION_KEYS = {"states", "equations", "signals", "parameters", "blocks"}
-_DESCRIPTION_NOT_NOMINAL = ("model file {path} is a model description (states and equations, the format of "
-                            "'hunting simulate --model'); diagnose takes a nominal model JSON with the keys plant, "
-                            "friction, controller, sensor (format in 'hunting diagnose --help', example: "
-                            "examples/emps/model.json in a checkout, or emps_model.json from 'hunting data emps')")
 
 
 def _looks_like_description(text: str) -> bool:
@@ -276,18 +284,23 @@ class NominalModel:
             d = json.loads(text)
         except json.JSONDecodeError as exc:
             if path.suffix.lower() in (".yaml", ".yml") or _looks_like_description(text):
-                raise SystemDefinitionError(_DESCRIPTION_NOT_NOMINAL.format(path=path)) from None
+                from ..describe import read_description
+                d = read_description(path)
+                return NominalModel.from_dict(d, where=f"model description {path}")
             raise SystemDefinitionError(f"model file {path} is not JSON ({exc.msg} at line {exc.lineno} column "
-                                        f"{exc.colno}); diagnose takes a nominal model JSON, see 'hunting diagnose "
-                                        "--help' and examples/emps/model.json") from None
-        if isinstance(d, dict) and _DESCRIPTION_KEYS & set(d):
-            raise SystemDefinitionError(_DESCRIPTION_NOT_NOMINAL.format(path=path))
-        return NominalModel.from_dict(d)
+                                        f"{exc.colno}); diagnose takes a nominal model JSON or a model description, "
+                                        "see 'hunting diagnose --help' and examples/emps/model.json") from None
+        return NominalModel.from_dict(d, where=f"model description {path}")
 
     @staticmethod
-    def from_dict(d: dict) -> "NominalModel":
+    def from_dict(d: dict, where: str = "model description") -> "NominalModel":
+        """The nominal model of the schema above, or of a model description (the equations
+        format of ``hunting.model``: read by :mod:`hunting.diagnose.from_description`, whose
+        errors are prefixed with ``where``)."""
         if not isinstance(d, dict):
             raise SystemDefinitionError(f"model = {d!r} must be a JSON object")
+        if _DESCRIPTION_KEYS & set(d):
+            return _from_description(d, where)
         unknown = set(d) - _NOMINAL_KEYS
         if unknown:
             raise SystemDefinitionError(f"model: unknown keys {sorted(unknown)}; allowed: preset, set, plant, "
@@ -352,6 +365,15 @@ class NominalModel:
                             controller=ctrl, source=d, cogging=_cogging(pl.get("cogging", []), pl.get("cogging_table", [])), delay=float(pl.get("delay", 0.0)),
                             flexibility=_flexibility(pl.get("flexibility")), lag=float(fr.get("lag", 0.0)),
                             dwell=_dwell(fr.get("dwell")), **sens)
+
+
+def _from_description(d: dict, where: str) -> NominalModel:
+    """The nominal model of the description d; its errors start with ``where``."""
+    from .from_description import nominal_from_description
+    try:
+        return nominal_from_description(d)
+    except SystemDefinitionError as exc:
+        raise SystemDefinitionError(f"{where}: {exc}") from None
 
 
 def _dwell(d) -> Dwell | None:
