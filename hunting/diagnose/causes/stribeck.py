@@ -12,7 +12,7 @@ from ._words import _q
 
 NAME = "stribeck"
 DESCRIPTION = "velocity-weakening (Stribeck) shape: levels and vs"
-FAMILY = "low speed"
+FAMILY = "friction curve"
 HYPERS = 1
 HYPER_KEYS = ("vs",)
 UNITS = {"Fc": "N", "Fs": "N", "vs": "m/s"}
