@@ -2,7 +2,7 @@
 
 The rule (stated in every report, :data:`RULE`):
 
-- force channel (offset, asymmetry, cogging, stribeck, viscous, mass, delay, flexibility, lag,
+- force channel (offset, asymmetry, cogging, level, stribeck, viscous, mass, delay, flexibility, lag,
   reversal): explanations, sets of at most ``max_causes`` causes, are searched by BIC on the
   fitting data's force residual, thinned and prewhitened by an AR noise model fitted on the
   residual of every candidate at once; a cause of the best explanation is kept when it explains
