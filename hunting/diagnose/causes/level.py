@@ -37,17 +37,18 @@ def hypers(kin, model) -> list:
 
 
 def untestable(kin, model) -> str | None:
-    """No level to scale, or a record that moves one way only (at least 10 % of the sliding
-    samples each way): in one direction sign(v) g(|v|) is a constant force while sliding, the
-    ``offset`` cause, and a change common to both directions cannot be told from it."""
+    """No level to scale, or a record that moves one way only (less than 10 % of the sliding
+    samples the other way) against a curve without a Stribeck dip: there sign(v) g(|v|) = Fc is a
+    constant force while sliding, the ``offset`` cause, and a change common to both directions
+    cannot be told from it (with a dip the regressor's shape in speed tells them apart)."""
     pos, neg = model.curve.positive, model.curve.negative
     if pos.Fc <= 0 and neg.Fc <= 0 and pos.Fs <= 0 and neg.Fs <= 0:
         return "the nominal model has no Coulomb or static friction to scale (offset, stribeck or asymmetry add it)"
     v = kin.v[kin.moving]
     share = min(np.mean(v > 0), np.mean(v < 0)) if v.size else 0.0
-    if share < 0.1:
+    if share < 0.1 and pos.Fs == pos.Fc and neg.Fs == neg.Fc:
         return (f"the record moves one way only ({share:.0%} of the sliding samples the other way): a level common "
-                "to both directions looks like a constant force (offset) there")
+                "to both directions of a curve without a Stribeck dip is a constant force (offset) there")
     return None
 
 
