@@ -196,6 +196,42 @@ def test_generation_is_deterministic_and_families_disjoint():
     assert f3["fit"]["q"].size != f1["fit"]["q"].size or not np.array_equal(f3["fit"]["q"], f1["fit"]["q"])
 
 
+def test_level_effect_scales_both_levels_of_both_directions():
+    """The ``level`` effect multiplies Fc and Fs of both directions by one factor k (viscous kept),
+    up or down, from 2 % to a factor 2; its truth holds the final Fc, Fs and k, and a careful
+    engineer's names (level, or stribeck judged on its levels)."""
+    seen = set()
+    for i, frac in enumerate((0.0, 0.5, 1.0, 1.0, 1.0, 1.0)):
+        d = draw.draft(np.random.default_rng([99, i]), ("level",), (frac,))
+        e = d.effects[0]
+        k = e["params"]["scale"]
+        assert max(k, 1 / k) - 1 == pytest.approx(e["size"], rel=1e-12)
+        assert e["size"] == pytest.approx(draw.at(frac, 0.02, 1.0), rel=1e-12)
+        for side in ("pos", "neg"):
+            t, n = getattr(d.plant, side), getattr(d.nominal, side)
+            assert (t.Fc, t.Fs, t.b, t.vs) == pytest.approx((k * n.Fc, k * n.Fs, n.b, n.vs), rel=1e-12)
+        assert (e["params"]["Fc"], e["params"]["Fs"]) == (d.plant.pos.Fc, d.plant.pos.Fs)
+        assert e["accept"] == ["level", "stribeck"] and e["variant"] == ("up" if k > 1 else "down")
+        seen.add(e["variant"])
+    assert seen == {"up", "down"}
+
+
+def test_families_drawn_before_level_keep_their_datasets():
+    """Adding ``level`` re-indexes nothing: tuning, reporting and test draw from ``draw.CAUSES``
+    (single effects cycling in its order) and never draw ``level``; tuning-level draws only it;
+    reporting2 draws every cause of ``draw.ALL_CAUSES``."""
+    for fam in ("tuning", "reporting", "test"):
+        plans = [generate.plan(fam, i) for i in range(sum(generate.SIZES[fam]))]
+        assert not any("level" in c for c, _ in plans)
+        n_clean, n_one, _ = generate.SIZES[fam]
+        if fam != "test":
+            assert [plans[n_clean + j][0][0] for j in range(13)] == list(draw.CAUSES)
+    assert {c for i in range(24) for c in generate.plan("tuning-level", i)[0]} == {"level"}
+    rep2 = [c for i in range(sum(generate.SIZES["reporting2"])) for c in generate.plan("reporting2", i)[0]]
+    assert set(rep2) == set(draw.ALL_CAUSES)
+    assert len(set(generate.FAMILIES.values())) == len(generate.FAMILIES)
+
+
 @pytest.fixture(scope="module")
 def blind_subset(tmp_path_factory):
     """The test family (10 clean, 10 strong single effects), generated and judged by the current

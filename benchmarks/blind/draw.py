@@ -9,7 +9,7 @@ drawn log-uniformly between a small value (near or below what the data can show)
 
 Every effect records its true parameters as final values (what the extended model should hold),
 under the names the diagnosis reports (``offset``, ``b_pos``/``b_neg``, ``pitch``/``amplitude_k``,
-``Fc``/``Fs``/``vs``, ``b``, ``mass``, ``delay``, ``load_mass``/``frequency``/``damping``/
+``Fc``/``Fs``/``vs``, ``Fc``/``Fs``/``scale`` (level), ``b``, ``mass``, ``delay``, ``load_mass``/``frequency``/``damping``/
 ``stiffness``, ``lag``, ``sigma0``/``sigma1``, ``level``/``gain``/``time``, ``saturation``,
 ``output_resolution``), and the names that count as finding it (``accept``: e.g. LuGre bristles are
 ``reversal`` or ``presliding``; a Coulomb-level asymmetry is a constant force while sliding, so
@@ -25,6 +25,10 @@ from .system import Controller, Curve, Noise, Plant, Sensor
 
 CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "flexibility", "lag", "reversal",
           "dwell", "saturation", "quantization")
+# effects added after the tuning and reporting sets were drawn: ``CAUSES`` keeps its order (the
+# datasets of those families are a function of it), families drawn since use ``ALL_CAUSES``
+LATER = ("level",)
+ALL_CAUSES = CAUSES + LATER
 # the validation metric of each effect's size: the force residual, or the re-simulated position
 # (LuGre bristles: either, as the diagnosis names them on both: reversal and presliding)
 BEHAVIOUR_CHANNEL = ("dwell", "saturation", "quantization")
@@ -34,11 +38,12 @@ EITHER_CHANNEL = ("reversal",)
 # Coulomb-level asymmetry against its constant force while sliding)
 PRIMARY = {"offset": ("offset",), "asymmetry": ("b_pos", "b_neg", "Fc_pos", "Fc_neg"),
            "cogging": ("pitch", "amplitude_1"), "presliding": ("sigma0",),
-           "stribeck": ("Fs",), "viscous": ("b",), "mass": ("mass",), "delay": ("delay",),
+           "stribeck": ("Fs",), "level": ("Fc", "Fs"), "viscous": ("b",), "mass": ("mass",), "delay": ("delay",),
            "flexibility": ("load_mass", "frequency"), "lag": ("lag",), "reversal": ("sigma0",), "dwell": ("gain",),
            "saturation": ("saturation",), "quantization": ("output_resolution",)}
 # pairs that cannot coexist in one plant
-_EXCLUSIVE = {frozenset(p) for p in (("reversal", "lag"), ("reversal", "dwell"))}
+# (a level change and a Stribeck-shape change both rescale the curve's levels: one plant holds one)
+_EXCLUSIVE = {frozenset(p) for p in (("reversal", "lag"), ("reversal", "dwell"), ("level", "stribeck"))}
 FREQS = (500.0, 800.0, 1000.0, 1000.0, 2000.0, 2500.0, 4000.0, 5000.0)
 MAX_SAMPLES = 20000
 
@@ -210,6 +215,22 @@ def _apply(d: Draft, p: Plant, c: Controller, cause: str, frac: float, rng, othe
             size = math.log(ratio) * (nom.Fs - nom.Fc) / Fc
         p = replace(p, pos=f(p.pos), neg=f(p.neg))
         params = {"Fc": p.pos.Fc, "Fs": p.pos.Fs, "vs": p.pos.vs}
+    elif cause == "level":
+        # the friction level of both directions scaled by one factor k, Coulomb and static level
+        # together (a normal-load, preload, wear or lubricant change scales mu(v) N as a whole;
+        # the viscous part is film shear and stays), up or down; size |k - 1| from 2 % (about
+        # the detection limit at the generator's 0.3-3 % force noise) to a factor 2 or 1/2.
+        # accept: ``level`` says it exactly; ``stribeck`` with the right levels says the same
+        # thing with a shape parameter more (its Fs is judged against the truth's: PRIMARY), so a
+        # careful engineer accepts it; ``offset`` (constant, not odd in v) or ``viscous`` (grows
+        # with speed) would name another force and do not count.
+        size = at(frac, 0.02, 1.0)
+        k = 1 + size if rng.random() < 0.5 else 1 / (1 + size)
+        f = lambda cv: replace(cv, Fc=cv.Fc * k, Fs=cv.Fs * k)  # noqa: E731
+        p = replace(p, pos=f(p.pos), neg=f(p.neg))
+        variant = "up" if k > 1 else "down"
+        accept = ("level", "stribeck")
+        params = {"Fc": p.pos.Fc, "Fs": p.pos.Fs, "scale": k}
     elif cause == "viscous":
         size = at(frac, 0.05, 2.0)
         k = 1 + size if rng.random() < 0.6 else 1 / (1 + size)
@@ -261,7 +282,7 @@ def _apply(d: Draft, p: Plant, c: Controller, cause: str, frac: float, rng, othe
         c = replace(c, dac=size * Fc / p.cm)
         params = {"output_resolution": c.dac}
     else:
-        raise ValueError(f"cause {cause!r} is not one of {CAUSES}")
+        raise ValueError(f"cause {cause!r} is not one of {ALL_CAUSES}")
     return p, c, dict(cause=cause, variant=variant, frac=float(frac), size=float(size), accept=list(accept),
                       params={k: float(v) for k, v in params.items()})
 

@@ -9,9 +9,17 @@ as final values and validation gains; the full true and nominal systems). ``inde
 the datasets of a set.
 
 Sets are seed families: each dataset's random stream is ``default_rng([FAMILY, index,
-attempt])``; the tuning and reporting families never share a stream.
+attempt])``; no two families share a stream.
+
+Families: ``tuning`` and ``reporting`` (the causes of ``draw.CAUSES``), ``test`` (the tests'
+short subset); ``tuning-level`` (24 single ``level`` effects, the effect added after the tuning
+set was drawn: adding it to ``tuning`` itself would have re-indexed every dataset, so it is an
+extra tuning directory with its own seed stream, judged together with ``tuning``'s clean
+datasets); ``reporting2`` (a never-seen reporting set: ``reporting``'s counts with every cause of
+``draw.ALL_CAUSES``, the level effect in proportion).
 
     python -m benchmarks.blind.generate tuning /work/wt/blind-data/tuning
+    python -m benchmarks.blind.generate tuning-level /work/wt/blind-data/tuning-level
     python -m benchmarks.blind.generate reporting /work/wt/blind-data/reporting
 """
 from __future__ import annotations
@@ -27,9 +35,14 @@ import numpy as np
 from . import draw, measures, programme
 from .system import Sensor, nominal_json, run
 
-FAMILIES = {"tuning": 1, "reporting": 2, "test": 3}
+FAMILIES = {"tuning": 1, "reporting": 2, "test": 3, "tuning-level": 4, "reporting2": 5}
 # (clean, single effect, two effects)
-SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0)}
+SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0), "tuning-level": (0, 24, 0),
+         "reporting2": (120, 224, 112)}
+# the causes each family draws its effects from (the families drawn before ``level`` existed keep
+# their list: their datasets are a function of it)
+FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.CAUSES, "tuning-level": ("level",),
+                 "reporting2": draw.ALL_CAUSES}
 # the tests' subset: short records, the strong half of the size range, ten causes
 SHORT = ("test",)
 TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
@@ -48,14 +61,15 @@ def plan(family: str, index: int, sizes=None) -> tuple[tuple, tuple]:
     j = index - n_clean
     if family == "test" and j < n_one:
         return (TEST_CAUSES[j % len(TEST_CAUSES)],), (0.6 + 0.4 * rng.random(),)
+    causes = FAMILY_CAUSES[family]
     if j < n_one:
-        k = len(draw.CAUSES)
+        k = len(causes)
         per = math.ceil(n_one / k)
         stratum = j // k
         # a per-cause permutation of the strata, so every cause covers the size range
         perm = np.random.default_rng([FAMILIES[family], 20_000 + j % k]).permutation(per)
-        return (draw.CAUSES[j % k],), ((perm[stratum] + rng.random()) / per,)
-    pairs = [(a, b) for i, a in enumerate(draw.CAUSES) for b in draw.CAUSES[i + 1:] if draw.compatible(a, b)]
+        return (causes[j % k],), ((perm[stratum] + rng.random()) / per,)
+    pairs = [(a, b) for i, a in enumerate(causes) for b in causes[i + 1:] if draw.compatible(a, b)]
     a, b = pairs[int(rng.integers(len(pairs)))]
     return (a, b), (float(rng.random()), float(rng.random()))
 

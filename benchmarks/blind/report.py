@@ -77,7 +77,7 @@ def summary(rows: list) -> dict:
     clean = [r for r in rows if not r["causes"]]
     single = [r for r in rows if len(r["causes"]) == 1]
     pairs = [r for r in rows if len(r["causes"]) == 2]
-    names = sorted({n for r in rows for n in r["reported"]} | set(draw.CAUSES))
+    names = sorted({n for r in rows for n in r["reported"]} | set(draw.ALL_CAUSES))
     fa_cause = {n: _rate(sum(n in r["reported"] for r in clean), len(clean)) for n in names}
     mod_single = [r for r in single if r["effects"][0]["moderate"]]
     mod_pairs = [r for r in pairs if all(e["moderate"] for e in r["effects"])]
@@ -146,7 +146,7 @@ def confusion(rows: list, kind: str = "single") -> tuple[list, list, dict]:
     for r in rows:
         if kind == "single" and not r["causes"]:
             add("clean", r)
-    for c in draw.CAUSES:
+    for c in draw.ALL_CAUSES:
         for r in rows:
             if kind == "single" and r["causes"] == [c]:
                 add(c, r)
@@ -183,7 +183,7 @@ def figure(judged: dict, path: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    causes = list(draw.CAUSES)
+    causes = list(draw.ALL_CAUSES)
     ncol = 5
     nrow = math.ceil(len(causes) / ncol)
     fig, axes = plt.subplots(nrow, ncol, figsize=(3.3 * ncol, 2.7 * nrow), sharey=True)
@@ -304,7 +304,7 @@ def markdown(set_name: str, judged: dict, figure_name: str | None = None) -> str
           "cells: named first / found / n.", "",
           "| cause | judge | " + " | ".join(lab for lab, *_ in detection_by_gain([], "offset")) + " |",
           "|---|---|" + "---|" * (len(GAIN_BINS) - 1)]
-    for c in draw.CAUSES:
+    for c in draw.ALL_CAUSES:
         for n in names:
             cells = [f"{f1}/{fd}/{k}" if k else "" for _, k, fd, f1 in detection_by_gain(judged[n], c)]
             L.append(f"| {c} | {n} | " + " | ".join(cells) + " |")
@@ -320,7 +320,7 @@ def markdown(set_name: str, judged: dict, figure_name: str | None = None) -> str
     L += ["", "### Effect sizes (validation gain when modelled, single effects)", "",
           "| cause | n | gain >= 0.15 | median gain |", "|---|---|---|---|"]
     rows0 = judged[names[0]]
-    for c in draw.CAUSES:
+    for c in draw.ALL_CAUSES:
         g = [r["effects"][0]["gain"] for r in rows0 if r["causes"] == [c]]
         if g:
             L.append(f"| {c} | {len(g)} | {sum(x >= MODERATE for x in g)} | {np.median(g):.2f} |")

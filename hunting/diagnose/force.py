@@ -20,7 +20,13 @@ grow the validation RMS by at least ``min_gain`` (relative) when dropped, and by
 ``PRECISION`` of the drive force's RMS (absolute: a model that reproduces the data to numerical
 precision has nothing left to explain; on noise-free records of the nominal model itself a
 residual of 1e-5 of the drive force otherwise passed as a 150 ns "delay"). Members that fail are
-removed one at a time (the smallest gain first) and the rest refitted. What remains is the
+removed one at a time (the smallest gain first) and the rest refitted; when nothing of the set
+holds, the BIC-best set of the search that holds none of the causes that failed is judged next
+(a BIC-best set that overfits the fitting data otherwise hides a single cause that alone explains
+the validation data). A member that is a special case of a cause of its family (``NESTS``: level
+of stribeck) gives way to it when the set with the general cause in its place explains the
+validation data better by ``min_gain``. Every change of the set drops at least one cause for good,
+so the loop ends. What remains is the
 explanation; the sets that came next in BIC and the causes of the same family (shared
 signature) that would replace a selected one are its alternatives."""
 from __future__ import annotations
@@ -268,6 +274,7 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
     noise_v = NoiseModel.fit(e_full, Sv.run)
     current = ranking[0]
     floor = PRECISION * _rms(lib.kv.force[lib.used_v])
+    dropped: set = set()          # causes that failed on the validation data: no later set holds them
     while True:
         tests = {}
         rms_full = lib.validation_rms(current)
@@ -299,7 +306,13 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
                                  p_value=tests[worst]["p_value"], validation_gain=tests[worst]["gain"],
                                  reason=_why(tests[worst], alpha, min_gain, alpha_reference)))
+            dropped.add(worst)
             current = _physical_subset(lib, fits, tuple(n for n in current.names if n != worst), rejected)
+            if not current.names:
+                # nothing of the BIC-best set held: the BIC-best set of the search that holds none
+                # of the causes that failed is judged next (a set that overfits the fitting data
+                # otherwise hides a single cause that alone explains the validation data)
+                current = next((e for e in ranking if e.names and not dropped & set(e.names)), current)
             continue
         # the whole set must also beat every smaller set of its causes by min_gain (two causes
         # fitted together can each look needed beside the other and still be worse than
@@ -312,10 +325,22 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                 if (rms_sub < (1 + min_gain) * rms_full or rms_sub - rms_full <= floor) and alt.physical:
                     beaten.append((len(sub), -alt.bic, sub, rms_sub, alt))
         if not beaten:
-            break
+            swap = _general_case(lib, fits, current, rms_full, min_gain, dropped)
+            if swap is None:
+                break
+            special, alt = swap
+            dropped.add(special)
+            rejected.append(dict(name=special, step="validation", statistic=tests[special]["t"],
+                                 p_value=tests[special]["p_value"], validation_gain=tests[special]["gain"],
+                                 reason=f"{', '.join(n for n in alt.names if n not in current.names)}, of which it is a "
+                                        f"special case, explains the validation data better by at least {min_gain:.0%} "
+                                        f"({lib.validation_rms(alt):.4g} against {rms_full:.4g} N RMS)"))
+            current = alt
+            continue
         _, _, sub, rms_sub, alt = max(beaten, key=lambda b: (b[0], b[1]))
         for name in current.names:
             if name not in sub:
+                dropped.add(name)
                 rejected.append(dict(name=name, step="validation", statistic=tests[name]["t"],
                                      p_value=tests[name]["p_value"], validation_gain=tests[name]["gain"],
                                      reason="with it the explanation does not beat {{{}}} on the validation data by {:.0%} "
@@ -336,6 +361,27 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                                  f"{alone.bic - fits[()].bic:+.1f} and the validation residual by {-gain:+.1%}")
     return dict(explanation=current, tests=tests if current.members else {}, rejected=list(last.values()),
                 ranking=ranking, noise_val=noise_v, fits=fits)
+
+
+def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: float, min_gain: float, dropped: set):
+    """(special, explanation) when a member of ``current`` is a special case of a cause of its
+    family (``NESTS`` of the general one: a level change is a Stribeck change without a change of
+    shape) and the set with the general cause in its place, each at its best variant, explains
+    the validation data better by at least min_gain: BIC on the fitting data favours the special
+    case by its fewer parameters, and the validation data decide whether the general one's extra
+    freedom is real (a Stribeck dip change otherwise came out as a level change plus a viscous
+    one). None otherwise."""
+    for name in current.names:
+        for general, mod in CAUSES.items():
+            if name not in getattr(mod, "NESTS", ()) or general in dropped or general not in lib.variants:
+                continue
+            names = tuple(n for n in lib.variants if n in (set(current.names) - {name}) | {general})
+            if not compatible(names):
+                continue
+            alt = fits.get(names) or lib.best_variants(names)
+            if alt.physical and lib.validation_rms(alt) < (1 - min_gain) * rms_full:
+                return name, alt
+    return None
 
 
 def compatible(names) -> bool:

@@ -2,7 +2,7 @@
 
 The rule (stated in every report, :data:`RULE`):
 
-- force channel (offset, asymmetry, cogging, stribeck, viscous, mass, delay, flexibility, lag,
+- force channel (offset, asymmetry, cogging, level, stribeck, viscous, mass, delay, flexibility, lag,
   reversal): explanations, sets of at most ``max_causes`` causes, are searched by BIC on the
   fitting data's force residual, thinned and prewhitened by an AR noise model fitted on the
   residual of every candidate at once; a cause of the best explanation is kept when it explains
@@ -11,7 +11,10 @@ The rule (stated in every report, :data:`RULE`):
   also its prediction along the reference trajectory, p < alpha_reference: feedback puts the
   sensor's and the actuator's noise into the measured regressors, not into the reference's),
   dropping it grows the validation RMS by at least ``min_gain``, and the whole set beats each of
-  its subsets by as much; what fails is removed and the rest refitted
+  its subsets by as much; what fails is removed and the rest refitted, and when nothing of the
+  set holds, the BIC-best set without the causes that failed is judged next; a special case
+  (level) gives way to the general cause of its family (stribeck) when that explains the
+  validation data better by ``min_gain``
   (:mod:`hunting.diagnose.force`, :mod:`hunting.diagnose.stats`);
 - causes with their own evidence (``CHANNEL = "own"``: dwell, saturation, quantization) bring a
   statistic with its p-value and a validation metric of their own (module docstrings); the same
@@ -49,7 +52,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "of its causes kept when it explains the validation residual of the others out of sample (one-sided test, "
         "prewhitened, autocorrelation-consistent standard error, p < {alpha:g}; with a moving reference its prediction "
         "along the reference too, p < {alpha_reference:g}), dropping it grows the validation RMS by at least "
-        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), and the set beats each of its subsets by as much; other channels: their own statistic at "
+        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck, when that explains the validation data better by as much); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%}")
 CRITERION = RULE
 

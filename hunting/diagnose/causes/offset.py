@@ -4,7 +4,7 @@ from ._words import _q
 
 NAME = "offset"
 DESCRIPTION = "constant force on the load"
-FAMILY = "level"
+FAMILY = "constant force"
 HYPERS = 0
 UNITS = {"offset": "N"}
 

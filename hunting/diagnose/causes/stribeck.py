@@ -12,10 +12,11 @@ from ._words import _q
 
 NAME = "stribeck"
 DESCRIPTION = "velocity-weakening (Stribeck) shape: levels and vs"
-FAMILY = "low speed"
+FAMILY = "friction curve"
 HYPERS = 1
 HYPER_KEYS = ("vs",)
 UNITS = {"Fc": "N", "Fs": "N", "vs": "m/s"}
+NESTS = ("level",)        # a level change is this change at the nominal shape (force.select decides between them)
 
 
 def hypers(kin, model) -> list:
