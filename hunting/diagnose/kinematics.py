@@ -245,7 +245,7 @@ def residual(kin: Kinematics, model) -> np.ndarray:
     noise-free records of loops with a two-sample delay)."""
     s = kin.slide
     cog = model.cogging_force(kin.q)
-    sliding = model.friction(kin.vf) + model.lag_force(kin.vf, kin.a_inst)
+    sliding = model.friction(kin.vf) + model.lag_force(kin.vf, kin.slide, kin.dt)
     if model.flexibility is not None:
         sliding = sliding + model.flexibility.force(kin.a_inst, kin.dt)
     drive = kin.delayed_drive(model.delay)

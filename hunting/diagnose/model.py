@@ -158,8 +158,8 @@ class NominalModel:
     cogging : tuple of :class:`hunting.models.plant.Cogging` components (harmonic or table),
     summed; flexibility : a :class:`Flexibility` (load on a spring behind the measured side; the
     force residual has it, the re-simulation does not); lag [s] : frictional memory of static
-    laws (the Stribeck level follows g(|v|) through a first-order lag; residual to first order and
-    re-simulation); dwell : a :class:`Dwell` (break-away force growing with the time at rest;
+    laws (the Stribeck level follows g(|v|) through a first-order lag, relaxing to Fs at rest;
+    residual and re-simulation, both exactly); dwell : a :class:`Dwell` (break-away force growing with the time at rest;
     re-simulation); delay [s] : actuation delay (the plant
     receives cm u(t - delay)); resolution [m] and sensor_noise [m] : the position sensor's
     quantization step and noise standard deviation before quantization (used by re-simulation;
@@ -214,14 +214,41 @@ class NominalModel:
         out[n] = -neg.level(-v[n]) + neg.b * v[n]
         return out
 
-    def lag_force(self, v, a) -> np.ndarray:
-        """The frictional memory's change of the friction force [N] to first order: the lagging
-        level g - lag dg/dt, i.e. -lag g'(|v|) a (v, a : (n,) [m/s, m/s^2]); 0 without lag."""
+    def lagged_level(self, v, slide, dt: float, lag: float | None = None) -> np.ndarray:
+        """The Stribeck level L [N] (n,) that follows g(|v|) through the first-order lag
+        L' = (g(|v|) - L) / lag (Hess and Soom's frictional memory), for velocities v (n,) [m/s]
+        sampled every dt [s]; where the mass sticks (``slide`` false, bool (n,)) it relaxes to the
+        static level Fs (the mean of the two directions'). Exact for g linear between samples
+        (first-order hold), at any lag, so a lag of many samples or longer than the passage
+        through the Stribeck dip is modelled as well as a short one; starts settled (L = g).
+        ``lag`` [s] defaults to the model's; 0 gives g itself."""
+        from scipy.signal import lfilter
         v = np.asarray(v, dtype=float)
-        if not self.lag:
+        lag = self.lag if lag is None else float(lag)
+        pos, neg = self.curve.positive, self.curve.negative
+        g = np.where(v >= 0, pos.level(v), neg.level(v))
+        g = np.where(np.asarray(slide, bool), g, 0.5 * (pos.Fs + neg.Fs))
+        if lag <= 0 or g.size == 0:
+            return g
+        e = np.exp(-dt / lag)
+        c = lag * (1.0 - e) / dt          # L_k+1 = e L_k + (1 - c) g_k+1 + (c - e) g_k
+        out, _ = lfilter([1.0 - c, c - e], [1.0, -e], g, zi=[c * g[0]])   # y_0 = g_0: settled
+        return out
+
+    def lag_force(self, v, slide, dt: float, lag: float | None = None) -> np.ndarray:
+        """The frictional memory's change of the sliding friction force [N] (n,): sign(v) (L - g)
+        with L the lagged level (:meth:`lagged_level`) and g the static one at v (n,) [m/s];
+        lower than the static curve while accelerating out of the Stribeck dip, higher while
+        decelerating into it (to first order -lag g'(|v|) a). 0 without lag and where the mass
+        sticks (``slide`` false)."""
+        v = np.asarray(v, dtype=float)
+        lag = self.lag if lag is None else float(lag)
+        if lag <= 0:
             return np.zeros_like(v)
-        slope = np.where(v >= 0, self.curve.positive.level_slope(v), self.curve.negative.level_slope(v))
-        return -self.lag * slope * np.asarray(a, dtype=float)
+        slide = np.asarray(slide, bool)
+        L = self.lagged_level(v, slide, dt, lag)
+        g = self.lagged_level(v, slide, dt, 0.0)
+        return np.where(slide, np.sign(v) * (L - g), 0.0)
 
     def v_stick(self) -> float:
         """Speed [m/s] below which this model's mass counts as stuck when judging data: a tenth

@@ -210,7 +210,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100:
         step = max(1, int(round(kf.window / fit.dt)) // 3)
         kr = reference_kinematics(validate, model, window=window)
-        lib = Library(force_names, kf, kv, model, kf.moving, kv.moving, step, kr)
+        inst = ((lambda m: reference_kinematics(validate, m, window=window)) if kr is not None and model.controller is not None
+                else None)
+        lib = Library(force_names, kf, kv, model, kf.moving, kv.moving, step, kr, inst)
         untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
         fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference), min_gain)
     else:
