@@ -25,7 +25,8 @@ holds, the BIC-best set of the search that holds none of the causes that failed 
 (a BIC-best set that overfits the fitting data otherwise hides a single cause that alone explains
 the validation data). A member that is a special case of a cause of its family (``NESTS``: level
 of stribeck) gives way to it when the set with the general cause in its place explains the
-validation data better by ``min_gain``. Every change of the set drops at least one cause for good,
+validation data better by ``min_gain``; a general cause gives way to its special case (viscous of
+asymmetry, level of stribeck) when it does not. Every change of the set drops at least one cause for good,
 so the loop ends. What remains is the
 explanation; the sets that came next in BIC and the causes of the same family (shared
 signature) that would replace a selected one are its alternatives."""
@@ -372,15 +373,27 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                     beaten.append((len(sub), -alt.bic, sub, rms_sub, alt))
         if not beaten:
             swap = _general_case(lib, fits, current, rms_full, min_gain, dropped)
+            if swap is not None:
+                special, alt = swap
+                dropped.add(special)
+                rejected.append(dict(name=special, step="validation", statistic=tests[special]["t"],
+                                     p_value=tests[special]["p_value"], validation_gain=tests[special]["gain"],
+                                     reason=f"{', '.join(n for n in alt.names if n not in current.names)}, of which it "
+                                            f"is a special case, explains the validation data better by at least "
+                                            f"{min_gain:.0%} ({lib.validation_rms(alt):.4g} against {rms_full:.4g} N RMS)"))
+                current = alt
+                continue
+            swap = _special_case(lib, fits, current, rms_full, min_gain, dropped)
             if swap is None:
                 break
-            special, alt = swap
-            dropped.add(special)
-            rejected.append(dict(name=special, step="validation", statistic=tests[special]["t"],
-                                 p_value=tests[special]["p_value"], validation_gain=tests[special]["gain"],
-                                 reason=f"{', '.join(n for n in alt.names if n not in current.names)}, of which it is a "
-                                        f"special case, explains the validation data better by at least {min_gain:.0%} "
-                                        f"({lib.validation_rms(alt):.4g} against {rms_full:.4g} N RMS)"))
+            general, alt = swap
+            dropped.add(general)
+            rejected.append(dict(name=general, step="validation", statistic=tests[general]["t"],
+                                 p_value=tests[general]["p_value"], validation_gain=tests[general]["gain"],
+                                 reason=f"its special case {', '.join(n for n in alt.names if n not in current.names)} "
+                                        f"explains the validation data as well, within {min_gain:.0%} "
+                                        f"({lib.validation_rms(alt):.4g} against {rms_full:.4g} N RMS): the extra "
+                                        f"freedom is not needed"))
             current = alt
             continue
         _, _, sub, rms_sub, alt = max(beaten, key=lambda b: (b[0], b[1]))
@@ -426,6 +439,27 @@ def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: floa
                 continue
             alt = fits.get(names) or lib.best_variants(names)
             if alt.physical and lib.validation_rms(alt) < (1 - min_gain) * rms_full:
+                return name, alt
+    return None
+
+
+def _special_case(lib: Library, fits: dict, current: Explanation, rms_full: float, min_gain: float, dropped: set):
+    """(general, explanation) when a member of ``current`` has a special case (its ``NESTS``: a
+    viscous change is a direction-dependent one with b+ and b- moved alike) and the set with the
+    special case in its place, at its best variant, explains the validation data as well, the
+    general one not better by min_gain (the complement of :func:`_general_case`'s condition, so
+    the two never disagree): the fitting data's BIC can favour the general case on noise alone,
+    and an engineer names the specific effect unless the extra freedom is needed. None
+    otherwise."""
+    for name in current.names:
+        for special in getattr(CAUSES[name], "NESTS", ()):
+            if special in dropped or special not in lib.variants:
+                continue
+            names = tuple(n for n in lib.variants if n in (set(current.names) - {name}) | {special})
+            if not compatible(names):
+                continue
+            alt = fits.get(names) or lib.best_variants(names)
+            if alt.physical and rms_full >= (1 - min_gain) * lib.validation_rms(alt):
                 return name, alt
     return None
 

@@ -14,6 +14,7 @@ FAMILY = "velocity"
 HYPERS = 0
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 EXCLUDES = ("viscous",)      # v = max(v, 0) + min(v, 0): viscous is the special case b+ = b-
+NESTS = ("viscous",)        # force.select names viscous unless b+ != b- explains the validation data better
 UNITS = {"b_pos": "N s/m", "b_neg": "N s/m"}
 
 
