@@ -17,7 +17,8 @@ HARMONICS = 3
 def hypers(kin, model) -> list:
     """Pitch candidates: the three strongest peaks of the Lomb-Scargle spectrum of the nominal
     force residual (averaged in position bins) against position (wavelengths from 20 samples'
-    travel at the typical speed to a quarter of the stroke), each refined on a +-3 % grid."""
+    travel at the slow end of the record's speeds (10th percentile) to half the stroke: two
+    periods), each refined on a +-3 % grid."""
     from scipy.signal import lombscargle
     from ..kinematics import residual
     moving = kin.moving
@@ -25,8 +26,11 @@ def hypers(kin, model) -> list:
         return []
     q, r = kin.q[moving], residual(kin, model)[moving]
     stroke = float(np.ptp(q))
-    step = float(np.median(np.abs(np.diff(kin.q)[moving[1:]])))
-    lo, hi = 20 * step, stroke / 4
+    # short pitches show where the motion is slow (a pitch shorter than 20 samples' travel at the
+    # median speed missed a 0.58 mm cogging moved at 13-58 mm/s, tuning d0088); two periods in
+    # the stroke suffice to tell a periodic force (a 1.7 mm pitch over 6.5 mm, d0153)
+    step = float(np.percentile(np.abs(np.diff(kin.q)[moving[1:]]), 10))
+    lo, hi = 5 * step, stroke / 2
     if not (lo > 0 and hi > lo):
         return []
     k = np.geomspace(1 / hi, 1 / lo, 1500)                  # wavenumbers [1/m], 0.2-0.4 % apart
