@@ -42,6 +42,7 @@ SCENARIOS = {
     "user model": ["simulate", "--model", str(USER_MODEL), "--x0", "x=0.5", "--t", "5"],
 }
 MODEL_SCENARIOS = {"user model"}      # also timed with the library cached and the model cache empty
+EXIT_CODES = {"bad argument": 2}       # the exit code each scenario must end with (default 0)
 
 # runs the command line inside a listener for numba's compile events; prints a JSON summary last
 RUNNER = r"""
@@ -68,13 +69,13 @@ print(json.dumps(dict(seconds=time.perf_counter() - t0, cpu=cpu, code=code, comp
 """
 
 
-def run(args: list[str], numba_cache: str, model_cache: str, root: Path) -> dict:
+def run(args: list[str], numba_cache: str, model_cache: str, root: Path, code: int = 0) -> dict:
     env = dict(os.environ, NUMBA_CACHE_DIR=numba_cache, HUNTING_CACHE_DIR=model_cache, PYTHONPATH=str(root))
     out = subprocess.run([sys.executable, "-c", RUNNER, *args], env=env, capture_output=True, text=True,
                          check=True, cwd=tempfile.gettempdir())
     res = json.loads(out.stdout.strip().splitlines()[-1])
-    if res["code"] != 0:
-        raise RuntimeError(f"hunting {' '.join(args)} exited with {res['code']}")
+    if res["code"] != code:
+        raise RuntimeError(f"hunting {' '.join(args)} exited with {res['code']}, not {code}")
     return res
 
 
@@ -104,9 +105,11 @@ def main() -> None:
             with tempfile.TemporaryDirectory() as tmp:
                 argv = [a.format(tmp=tmp) for a in args]
                 cache, models = os.path.join(tmp, "numba"), os.path.join(tmp, "models")
-                cold = run(argv, cache, models, root)
-                warm = run(argv, cache, models, root)
-                lone = run(argv, cache, os.path.join(tmp, "models2"), root) if name in MODEL_SCENARIOS else None
+                code = EXIT_CODES.get(name, 0)
+                cold = run(argv, cache, models, root, code)
+                warm = run(argv, cache, models, root, code)
+                lone = (run(argv, cache, os.path.join(tmp, "models2"), root, code) if name in MODEL_SCENARIOS
+                        else None)
             colds.append((cold, warm, lone))
         cold, warm, lone = min(colds, key=lambda c: c[0]["cpu"])
         print(f"{name:<16}{cold['seconds']:>10.1f}/{cold['cpu']:<8.1f}{warm['seconds']:>10.2f}/{warm['cpu']:<8.2f}"

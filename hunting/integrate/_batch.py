@@ -35,84 +35,52 @@ BATCH_SIG = types.void(
     types.float64, types.float64[::1], types.int64, types.int64, types.float64[::1],
     types.int64, types.int64,
     types.float64[:, ::1], types.int64[::1], types.int64[::1], types.int64[::1], types.float64[:, ::1],
-    types.int64, types.int64, types.float64[::1], types.int64[::1],
+    types.int64, types.int64,
 )
 
-ZENO_COUNT = 50             # Zeno detection: this many events within 1e-10 time units
 MIN_ROWS_PER_THREAD = 4     # fewer rows run in the calling thread (a hand-off costs ~0.1 ms)
 CHUNKS_PER_THREAD = 4       # run times differ between rows: small chunks balance the threads
 
 
-def batch_workspace_sizes(n: int, ng: int, n_modes: int, n_params: int, max_events: int) -> tuple[int, int]:
-    """Sizes (float, int) of the workspaces one batch_kernel call needs."""
-    nf, ni = K.workspace_sizes(n, n, ng, n_modes, ZENO_COUNT)
-    cap = max_events + 1
-    return (nf + n_params + 2 + 3 * n + cap * (1 + 2 * n) + K.N_FINFO,
-            ni + n_modes * ng + 1 + 3 * cap + K.N_INFO)
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)   # compiled for BATCH_SIG on first use
+@numba.njit(cache=True, nogil=True, error_model="numpy")     # compiled for BATCH_SIG on first use
 def batch_kernel(kernel, vf, guards, reset, jac, mode_of, has_jac, method,
                  X0, mode0, t_max, p, directions,
                  rtol, atol, max_steps, max_events, guard_tol,
                  stop_mode, stop_count,
-                 X_end, mode_end, status, n_events, fout, lo, hi, wfa, wia):
+                 X_end, mode_end, status, n_events, fout, lo, hi):
     """Integrate rows lo:hi of X0 (m, n) from t = 0 until the stop condition with ``kernel``
     (a compiled integration kernel, see ``_kernel.kernel_for``).
 
     atol and guard_tol are per run (m,) so that maps on small amplitudes keep relative accuracy.
     Outputs (rows lo:hi): X_end (m, n), mode_end (m,), status (m,), n_events (m,), and fout
     (m, 3): time at the end, time of the first event, total time spent in ``stop_mode`` before
-    the end. wfa, wia: float and int workspaces of ``batch_workspace_sizes`` entries, one pair
-    per concurrent call. Every work array is a view of them: the batch allocates nothing and
-    compiles without reference counting (its allocations were ~0.7 s of its compile)."""
+    the end."""
     n = X0.shape[1]
     n_modes = directions.shape[0]
     ng = directions.shape[1]
-    nf, ni = K.workspace_sizes(n, n, ng, n_modes, ZENO_COUNT)
-    cap = max_events + 1
-    wf = wfa[0:nf]
-    o = nf
+    nf, ni = K.workspace_sizes(n, n, ng, n_modes, 50)
+    wf = np.empty(nf)
+    wi = np.empty(ni, dtype=np.int64)
     # copies of the shared arrays per call (per thread): reference counting on one array from
-    # several threads made its cache line bounce between cores
-    p_k = wfa[o:o + p.size]
-    o += p.size
-    for i in range(p.size):
-        p_k[i] = p[i]
-    out_t = wfa[o:o + 1]
-    o += 1
-    out_x = wfa[o:o + n].reshape((1, n))
-    o += n
-    ev_t = wfa[o:o + cap]
-    o += cap
-    ev_xb = wfa[o:o + cap * n].reshape((cap, n))
-    o += cap * n
-    ev_xa = wfa[o:o + cap * n].reshape((cap, n))
-    o += cap * n
-    finfo = wfa[o:o + K.N_FINFO]
-    o += K.N_FINFO
-    xf = wfa[o:o + n]
-    o += n
-    x0 = wfa[o:o + n]
-    o += n
-    te = wfa[o:o]
-    no_dir = wfa[o:o].reshape((0, 0))
-    wi = wia[0:ni]
-    o = ni
-    dir_k = wia[o:o + n_modes * ng].reshape((n_modes, ng))
-    o += n_modes * ng
-    for i in range(n_modes):
-        for j in range(ng):
-            dir_k[i, j] = directions[i, j]
-    out_m = wia[o:o + 1]
-    o += 1
-    ev_g = wia[o:o + cap]
-    o += cap
-    ev_f = wia[o:o + cap]
-    o += cap
-    ev_to = wia[o:o + cap]
-    o += cap
-    info = wia[o:o + K.N_INFO]
+    # several threads makes its cache line bounce between cores
+    p_k = p.copy()
+    dir_k = directions.copy()
+    out_t = np.empty(1)
+    out_x = np.empty((1, n))
+    out_m = np.empty(1, dtype=np.int64)
+    cap = max_events + 1
+    ev_t = np.empty(cap)
+    ev_xb = np.empty((cap, n))
+    ev_xa = np.empty((cap, n))
+    ev_g = np.empty(cap, dtype=np.int64)
+    ev_f = np.empty(cap, dtype=np.int64)
+    ev_to = np.empty(cap, dtype=np.int64)
+    info = np.zeros(K.N_INFO, dtype=np.int64)
+    finfo = np.zeros(K.N_FINFO)
+    xf = np.empty(n)
+    x0 = np.empty(n)
+    te = np.empty(0)
+    no_dir = np.empty((0, 0))
     for k in range(lo, hi):
         for i in range(n):
             x0[i] = X0[k, i]
@@ -121,7 +89,7 @@ def batch_kernel(kernel, vf, guards, reset, jac, mode_of, has_jac, method,
         kernel(vf, guards, reset, jac, mode_of, has_jac, method, n, 0.0, t_max,
                x0, mode0[k], p_k, no_dir, dir_k, rtol, atol[k], 0.0,
                np.inf, max_steps, max_events, guard_tol[k], False, te, False, stop_mode,
-               stop_count, ZENO_COUNT, 1e-10, out_t, out_x, out_m,
+               stop_count, 50, 1e-10, out_t, out_x, out_m,
                ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo, xf, wf, wi)
         st = info[K.I_STATUS]
         if st == K._S_FULL:
@@ -189,15 +157,12 @@ def run_batch(system, X0, mode0, *, t_max: float, atol, rtol: float = 1e-12, met
     kernel = K.kernel_for(int(method))
     batch = K.compile_for(batch_kernel, BATCH_SIG)
 
-    nfa, nia = batch_workspace_sizes(X0.shape[1], system.directions.shape[1], system.directions.shape[0],
-                                     system.params.size, int(max_events))
-
     def rows(lo: int, hi: int) -> None:
         batch(kernel, system.vector_field, system.guards, system.transition, jac, system.mode_of,
               system.jacobian is not None, int(method), X0, mode0, float(t_max), system.params,
               system.directions, float(rtol), atol, int(max_steps), int(max_events),
               guard_tol, int(stop_mode), int(stop_count), X_end, mode_end, status, n_events,
-              fout, lo, hi, np.empty(nfa), np.empty(nia, dtype=np.int64))
+              fout, lo, hi)
 
     workers = min(n_threads() if threads is None else max(1, int(threads)), m // MIN_ROWS_PER_THREAD)
     if workers <= 1:
