@@ -24,12 +24,14 @@ taken from the mode, not from ``x``): events are then located on smooth interpol
 from __future__ import annotations
 
 import copy
+import warnings
 from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
 
 import numba
 import numpy as np
 from numba import types
+from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ._fastcall import install as _install_fastcall
 from .errors import SystemDefinitionError
@@ -53,6 +55,22 @@ MODE_TYPE = types.FunctionType(MODE_SIG)
 JAC_TYPE = types.FunctionType(JAC_SIG)
 
 MODE_KINDS = ("smooth", "stick", "filippov")
+
+
+def compile_for(disp, sig):
+    """Compile numba dispatcher ``disp`` for signature ``sig`` unless it has an overload (numba
+    loads it from its disk cache when there) and disable compilation for other types: arguments
+    that do not match are an error instead of a silent new specialization. What
+    ``numba.njit(sig)`` does at import, done on first use (so importing a module compiles
+    nothing a command does not run). Returns ``disp``."""
+    if not disp.overloads:
+        with warnings.catch_warnings():
+            # compiling inside a caller's warning context (pytest's resets the filter that
+            # hunting._fastcall installs at import)
+            warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
+            disp.compile(sig)
+        disp.disable_compile()
+    return disp
 
 
 @numba.njit(JAC_SIG, cache=True, error_model="numpy")

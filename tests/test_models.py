@@ -149,3 +149,23 @@ def test_with_params_shares_compiled_functions():
     assert s2.vector_field is sys_.vector_field and s2.param("kp") == 20.0 and sys_.param("kp") == 10.0
     with pytest.raises(SystemDefinitionError, match=r"parameter 'P' is not a parameter of table9.1"):
         sys_.with_params(P=1.0)
+
+
+def test_preset_functions_compile_on_first_use_once():
+    # importing the models compiles nothing (a user model or `hunting models` must not pay for
+    # the preset loops); building a preset's system compiles each protocol function once, for
+    # its signature only, and later presets reuse them
+    import subprocess
+    import sys
+    code = ("import hunting.models, hunting.models.servo as S; "
+            "fs = (S.servo_vf, S.servo_guards, S.servo_reset, S.servo_mode_of, S.servo_jac); "
+            "print([len(f.overloads) for f in fs])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[0, 0, 0, 0, 0]"
+    from hunting.models import servo as S
+    preset("table9.1").system
+    preset("table8.1-lugre").system
+    fs = (S.servo_vf, S.servo_guards, S.servo_reset, S.servo_mode_of, S.servo_jac)
+    assert [len(f.overloads) for f in fs] == [1] * 5
+    with pytest.raises(TypeError):
+        S.servo_vf(0, 0.0, np.zeros(3, dtype=np.int64), np.zeros(3), np.zeros(3))   # no new specialization

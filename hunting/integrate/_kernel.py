@@ -12,17 +12,14 @@ velocity that was just set to zero by a transition -- are *unarmed*: they are sa
 dense output and armed once they have moved away from zero on the non-firing side. An unarmed
 guard that instead moves beyond ``guard_tol`` on the firing side fires at that threshold.
 """
-import warnings
-
 import numba
 import numpy as np
 from numba import types
-from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..errors import Status
-from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE
+from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE, compile_for
 from ._rhs import jacobian_central_or_exact, param_step, rhs
-from ._steppers import (EPS, dense_eval, explicit_dense, explicit_step, numerical_jacobian,
+from ._steppers import (EPS, dense_eval, dop853_step, dp5_step, explicit_dense, numerical_jacobian,
                         radau_dense, radau_step, select_initial_step)
 from ._tableau import METHOD_DOP853, METHOD_DP5, METHOD_RADAU
 
@@ -177,11 +174,14 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
 @numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp, y_new, f_new,
               err, full):
-    """One explicit step (see explicit_step), compiled once for event polishing. The main loop
-    inlines explicit_step itself (its hot path); a second inlined copy in polishing doubled the
-    kernel's compile time."""
-    return explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
-                         y_new, f_new, err, full)
+    """One explicit step (DP5 or DOP853; ``full`` None: DOP853 only), compiled once for event
+    polishing. The main loop inlines the step itself (its hot path); a second inlined copy in
+    polishing doubled the kernel's compile time."""
+    if full is not None and method == METHOD_DP5:
+        return dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
+                        y_new, f_new, err, full)
+    return dop853_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
+                       y_new, f_new, err, full)
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -563,9 +563,14 @@ def _make_kernel(full_flag):
                     continue
             else:
                 # inlined here (the hot path: a call passing ~25 array arguments cost 5-8 % per
-                # step); event polishing calls the compiled copy _explicit
-                en = explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K,
-                                   ytmp, y_new, f_new, err, full)
+                # step); event polishing calls the compiled copy _explicit. The lean kernel prunes
+                # the DP5 branch before inlining, so it never copies the DP5 step.
+                if full is not None and method == METHOD_DP5:
+                    en = dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K,
+                                  ytmp, y_new, f_new, err, full)
+                else:
+                    en = dop853_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K,
+                                     ytmp, y_new, f_new, err, full)
                 nfev += 12 if method == METHOD_DOP853 else 6
             finite = np.isfinite(en)
             for i in range(n):
@@ -780,21 +785,6 @@ def _make_kernel(full_flag):
 
 _OPTIONS = dict(cache=True, error_model="numpy", _nrt=False, nogil=True)
 _DISPATCHERS = {"lean": numba.njit(**_OPTIONS)(_make_kernel(None)), "full": numba.njit(**_OPTIONS)(_make_kernel(True))}
-
-
-def compile_for(disp, sig):
-    """Compile dispatcher ``disp`` for signature ``sig`` unless it has an overload (numba loads
-    it from its disk cache when there) and disable compilation for other types: arguments that
-    do not match are an error instead of a silent per-system specialization. What
-    ``numba.njit(sig)`` does at import, done on first use."""
-    if not disp.overloads:
-        with warnings.catch_warnings():
-            # compiling inside a caller's warning context (pytest's resets the filter that
-            # hunting._fastcall installs at import)
-            warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
-            disp.compile(sig)
-        disp.disable_compile()
-    return disp
 
 
 def compiled(kind: str):

@@ -63,41 +63,51 @@ def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, 
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def explicit_step(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
-                  f_new, err, full):
-    """One explicit Runge-Kutta step (DP5 or DOP853, FSAL). Returns the scaled error norm.
+def dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
+             f_new, err, full):
+    """One Dormand-Prince 5(4) step (FSAL). Returns the scaled error norm.
 
-    K: (16, n) stage derivatives (rows 0..6 used by DP5, 0..12 by DOP853); writes y_new, f_new.
-    ``full`` None: DOP853 only (the lean kernel; the DP5 branch is pruned before typing)."""
+    K: (16, n) stage derivatives (rows 0..6); writes y_new, f_new. The explicit steppers are two
+    functions, not one with a method branch: the kernels choose between them under
+    ``full is not None``, which numba prunes before inlining, so the lean kernel never inlines
+    (copies, then discards) the DP5 step (~0.5 s of its compile)."""
     n = y.size
-    if full is not None and method == METHOD_DP5:
-        ns = 6
-        for i in range(n):
-            K[0, i] = f[i]
-        for s in range(1, ns):
-            for i in range(n):
-                acc = 0.0
-                for j in range(s):
-                    acc += DP5_A[s, j] * K[j, i]
-                ytmp[i] = y[i] + h * acc
-            rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + DP5_C[s] * h, ytmp, p, err, full)
-            for i in range(n):
-                K[s, i] = err[i]
+    ns = 6
+    for i in range(n):
+        K[0, i] = f[i]
+    for s in range(1, ns):
         for i in range(n):
             acc = 0.0
-            for j in range(ns):
-                acc += DP5_B[j] * K[j, i]
-            y_new[i] = y[i] + h * acc
-        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new, full)
+            for j in range(s):
+                acc += DP5_A[s, j] * K[j, i]
+            ytmp[i] = y[i] + h * acc
+        rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + DP5_C[s] * h, ytmp, p, err, full)
         for i in range(n):
-            K[ns, i] = f_new[i]
-        for i in range(n):
-            acc = 0.0
-            for j in range(ns + 1):
-                acc += DP5_E[j] * K[j, i]
-            err[i] = h * acc
-        return _rms_scaled(err, y, y_new, rtol, atol)
-    # DOP853
+            K[s, i] = err[i]
+    for i in range(n):
+        acc = 0.0
+        for j in range(ns):
+            acc += DP5_B[j] * K[j, i]
+        y_new[i] = y[i] + h * acc
+    rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t + h, y_new, p, f_new, full)
+    for i in range(n):
+        K[ns, i] = f_new[i]
+    for i in range(n):
+        acc = 0.0
+        for j in range(ns + 1):
+            acc += DP5_E[j] * K[j, i]
+        err[i] = h * acc
+    return _rms_scaled(err, y, y_new, rtol, atol)
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def dop853_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
+                f_new, err, full):
+    """One DOP853 step (FSAL). Returns Hairer's error norm (3rd/5th order mix).
+
+    K: (16, n) stage derivatives (rows 0..12; 13..15 are the dense output's); writes y_new,
+    f_new."""
+    n = y.size
     ns = D853_NS
     for i in range(n):
         K[0, i] = f[i]

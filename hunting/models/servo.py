@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from ..sliding import direction_from_rest
-from ..system import GUARD_SIG, JAC_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, PiecewiseSystem
+from ..system import GUARD_SIG, JAC_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, PiecewiseSystem, compile_for
 from .friction import lugre_partials, lugre_rates, slip_force, stribeck_level_slope
 from .plant import cogging_force, cogging_slope, external_force
 
@@ -63,7 +63,7 @@ def _slip(v, s, p):
     return slip_force(v, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4])
 
 
-@numba.njit(VF_SIG, cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False)    # compiled for VF_SIG on first use
 def servo_vf(mode, t, x, p, out):
     model = p[MODEL]
     F = nonfriction_force(t, x, p)
@@ -99,7 +99,7 @@ def servo_vf(mode, t, x, p, out):
         out[3] = zdot
 
 
-@numba.njit(JAC_SIG, cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False)    # compiled for JAC_SIG on first use
 def servo_jac(mode, t, x, p, J):
     """Analytic Jacobian of :func:`servo_vf` in ``mode`` (the mode's smooth field)."""
     n = x.size
@@ -149,7 +149,7 @@ def servo_jac(mode, t, x, p, J):
     J[1, 2] = F3 / m
 
 
-@numba.njit(GUARD_SIG, cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False)    # compiled for GUARD_SIG on first use
 def servo_guards(mode, t, x, p, out):
     model = p[MODEL]
     if model == MODEL_SWITCH:
@@ -188,7 +188,7 @@ def _switch_mode_at_rest(t, x, p):
     return STICK
 
 
-@numba.njit(RESET_SIG, cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False)    # compiled for RESET_SIG on first use
 def servo_reset(mode, guard, t, x, p, x_out):
     for i in range(x.size):
         x_out[i] = x[i]
@@ -209,7 +209,7 @@ def servo_reset(mode, guard, t, x, p, x_out):
     return V_NEG if mode == V_POS else V_POS
 
 
-@numba.njit(MODE_SIG, cache=True, error_model="numpy", _nrt=False)
+@numba.njit(cache=True, error_model="numpy", _nrt=False)    # compiled for MODE_SIG on first use
 def servo_mode_of(t, x, p):
     model = p[MODEL]
     if model == MODEL_SWITCH:
@@ -245,6 +245,11 @@ MODE_TABLES = {
 
 def build_servo_system(name: str, params: np.ndarray, *, odd: bool, units: dict) -> PiecewiseSystem:
     """Wrap a flat servo parameter array (layout above) into a PiecewiseSystem."""
+    # compiled here, not at import: a command that never builds a preset loop (a user model,
+    # `hunting models`, --help) does not pay the ~3 s of compiling these on a fresh install
+    for fn, sig in ((servo_vf, VF_SIG), (servo_guards, GUARD_SIG), (servo_reset, RESET_SIG),
+                    (servo_mode_of, MODE_SIG), (servo_jac, JAC_SIG)):
+        compile_for(fn, sig)
     model = int(params[MODEL])
     modes, guard_names, directions, mirror = MODE_TABLES[model]
     states = ("x1", "x2", "x3") + (("x4",) if model == MODEL_LUGRE else ())
