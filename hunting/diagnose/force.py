@@ -372,28 +372,14 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                 if (rms_sub < (1 + min_gain) * rms_full or rms_sub - rms_full <= floor) and alt.physical:
                     beaten.append((len(sub), -alt.bic, sub, rms_sub, alt))
         if not beaten:
-            swap = _general_case(lib, fits, current, rms_full, min_gain, dropped)
-            if swap is not None:
-                special, alt = swap
-                dropped.add(special)
-                rejected.append(dict(name=special, step="validation", statistic=tests[special]["t"],
-                                     p_value=tests[special]["p_value"], validation_gain=tests[special]["gain"],
-                                     reason=f"{', '.join(n for n in alt.names if n not in current.names)}, of which it "
-                                            f"is a special case, explains the validation data better by at least "
-                                            f"{min_gain:.0%} ({lib.validation_rms(alt):.4g} against {rms_full:.4g} N RMS)"))
-                current = alt
-                continue
-            swap = _special_case(lib, fits, current, rms_full, min_gain, dropped)
+            swap = (_general_case(lib, fits, current, rms_full, min_gain, dropped)
+                    or _special_case(lib, fits, current, rms_full, min_gain, dropped))
             if swap is None:
                 break
-            general, alt = swap
-            dropped.add(general)
-            rejected.append(dict(name=general, step="validation", statistic=tests[general]["t"],
-                                 p_value=tests[general]["p_value"], validation_gain=tests[general]["gain"],
-                                 reason=f"its special case {', '.join(n for n in alt.names if n not in current.names)} "
-                                        f"explains the validation data as well, within {min_gain:.0%} "
-                                        f"({lib.validation_rms(alt):.4g} against {rms_full:.4g} N RMS): the extra "
-                                        f"freedom is not needed"))
+            out, alt, why = swap
+            dropped.add(out)
+            rejected.append(dict(name=out, step="validation", statistic=tests[out]["t"], p_value=tests[out]["p_value"],
+                                 validation_gain=tests[out]["gain"], reason=why))
             current = alt
             continue
         _, _, sub, rms_sub, alt = max(beaten, key=lambda b: (b[0], b[1]))
@@ -423,7 +409,7 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
 
 
 def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: float, min_gain: float, dropped: set):
-    """(special, explanation) when a member of ``current`` is a special case of a cause of its
+    """(special, explanation, reason) when a member of ``current`` is a special case of a cause of its
     family (``NESTS`` of the general one: a level change is a Stribeck change without a change of
     shape) and the set with the general cause in its place, each at its best variant, explains
     the validation data better by at least min_gain: BIC on the fitting data favours the special
@@ -438,13 +424,15 @@ def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: floa
             if not compatible(names):
                 continue
             alt = fits.get(names) or lib.best_variants(names)
-            if alt.physical and lib.validation_rms(alt) < (1 - min_gain) * rms_full:
-                return name, alt
+            rms = lib.validation_rms(alt)
+            if alt.physical and rms < (1 - min_gain) * rms_full:
+                return name, alt, (f"{general}, of which it is a special case, explains the validation data better "
+                                   f"by at least {min_gain:.0%} ({rms:.4g} against {rms_full:.4g} N RMS)")
     return None
 
 
 def _special_case(lib: Library, fits: dict, current: Explanation, rms_full: float, min_gain: float, dropped: set):
-    """(general, explanation) when a member of ``current`` has a special case (its ``NESTS``: a
+    """(general, explanation, reason) when a member of ``current`` has a special case (its ``NESTS``: a
     viscous change is a direction-dependent one with b+ and b- moved alike) and the set with the
     special case in its place, at its best variant, explains the validation data as well, the
     general one not better by min_gain (the complement of :func:`_general_case`'s condition, so
@@ -459,8 +447,11 @@ def _special_case(lib: Library, fits: dict, current: Explanation, rms_full: floa
             if not compatible(names):
                 continue
             alt = fits.get(names) or lib.best_variants(names)
-            if alt.physical and rms_full >= (1 - min_gain) * lib.validation_rms(alt):
-                return name, alt
+            rms = lib.validation_rms(alt)
+            if alt.physical and rms_full >= (1 - min_gain) * rms:
+                return name, alt, (f"its special case {special} explains the validation data as well, within "
+                                   f"{min_gain:.0%} ({rms:.4g} against {rms_full:.4g} N RMS): the extra freedom is "
+                                   "not needed")
     return None
 
 
