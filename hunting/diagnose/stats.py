@@ -146,6 +146,8 @@ def long_run_meat(X: np.ndarray, e: np.ndarray, run: np.ndarray, *, lags: int = 
     z0 = float(z @ z)
     Xs = X * s[:, None]
     S = Xs.T @ Xs
+    if not z0 > 0:                      # e is zero: no autocorrelation to estimate
+        return S
     for k in range(1, lags + 1):
         t = lagged(run, k)
         if t.size == 0:
@@ -192,5 +194,9 @@ def out_of_sample(e0: np.ndarray, yhat: np.ndarray, run: np.ndarray, noise: Nois
     gamma = float(yw @ ew) / ss
     eps = ew - gamma * yw
     var = float(long_run_meat(yw[:, None], eps, rw)[0, 0]) / ss ** 2
-    t = gamma / np.sqrt(var) if var > 0 else (np.inf if gamma > 0 else 0.0)
+    if not (np.isfinite(var) and var > 0):
+        # the prediction reproduces the residual exactly (or overflows): no variance, no test.
+        # Seen with a diverging prediction (1.9e24 N) whose fit left no residual on 105 samples
+        return gamma, 0.0, 1.0
+    t = gamma / np.sqrt(var)
     return gamma, float(t), float(stats.norm.sf(t))
