@@ -11,7 +11,7 @@ import pytest
 
 from hunting.cli import main
 from hunting.diagnose import NominalModel, save_csv
-from hunting.diagnose.from_description import nominal_from_description
+from hunting.diagnose.model import nominal_from_description
 from hunting.diagnose.synthetic import TruePlant, generate
 from hunting.errors import SystemDefinitionError
 
@@ -178,8 +178,8 @@ def test_docstring_examples():
     import doctest
 
     from hunting.describe import mechanical
-    from hunting.diagnose import from_description
-    for mod in (mechanical, from_description):
+    from hunting.diagnose import model
+    for mod in (mechanical, model):
         res = doctest.testmod(mod)
         assert res.failed == 0 and res.attempted > 0
 

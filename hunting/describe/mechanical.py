@@ -23,7 +23,7 @@ naming the key and what is allowed, never an approximation:
   entering through one name (a parameter or a signal of t) either as the error ``q - r`` in every
   term (derivative on the error) or in the P and I terms only (derivative on the measurement).
 
-Used by ``hunting diagnose --model DESCRIPTION`` (:mod:`hunting.diagnose.from_description`);
+Used by ``hunting diagnose --model DESCRIPTION`` (:func:`hunting.diagnose.model.nominal_from_description`);
 nothing here knows about diagnosis.
 """
 from __future__ import annotations

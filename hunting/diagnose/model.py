@@ -1,6 +1,6 @@
 """The nominal model a diagnosis starts from: plant, friction law, controller, read from the
 MODEL.json schema of ``hunting diagnose`` (or a preset, or a model description through
-:mod:`hunting.diagnose.from_description`), with the static friction map the force residual needs.
+:func:`nominal_from_description`), with the static friction map the force residual needs.
 
 Schema (keys beyond these are errors, so typos are caught):
 
@@ -20,6 +20,7 @@ Schema (keys beyond these are errors, so typos are caught):
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -138,7 +139,7 @@ def highpass_response(a: np.ndarray, dt: float, frequency: float, damping: float
 
 _NOMINAL_KEYS = {"preset", "set", "plant", "friction", "controller", "sensor"}
 # the keys of a model description (hunting.describe: states and equations), read by
-# from_description.nominal_from_description
+# nominal_from_description
 _DESCRIPTION_KEYS = {"states", "equations", "signals", "parameters", "blocks"}
 
 
@@ -322,7 +323,7 @@ class NominalModel:
     @staticmethod
     def from_dict(d: dict, where: str = "model description") -> "NominalModel":
         """The nominal model of the schema above, or of a model description (the equations
-        format of ``hunting.model``: read by :mod:`hunting.diagnose.from_description`, whose
+        format of ``hunting.model``: read by :func:`nominal_from_description`, whose
         errors are prefixed with ``where``)."""
         if not isinstance(d, dict):
             raise SystemDefinitionError(f"model = {d!r} must be a JSON object")
@@ -396,7 +397,6 @@ class NominalModel:
 
 def _from_description(d: dict, where: str) -> NominalModel:
     """The nominal model of the description d; its errors start with ``where``."""
-    from .from_description import nominal_from_description
     try:
         return nominal_from_description(d)
     except SystemDefinitionError as exc:
@@ -453,3 +453,77 @@ def fit_coulomb_viscous(kin, *, v_min_frac: float = 0.02) -> tuple[NominalModel,
     return model, {"mass": float(sd[0]), "Fc": float(sd[1]), "b": float(sd[2])}
 
 
+def nominal_from_description(description, **overrides) -> NominalModel:
+    """The :class:`NominalModel` of a model description.
+
+    Parameters
+    ----------
+    description : dict, str or Path
+        A model description (dict), or the path of a JSON or YAML file holding one.
+    **overrides : float
+        Parameter values replacing the description's defaults.
+
+    Returns
+    -------
+    NominalModel
+        Its ``source`` is the nominal-model JSON it maps to (``to_dict()``).
+
+    Raises
+    ------
+    SystemDefinitionError
+        One line naming the part of the description that has no exact nominal-model reading
+        (see :mod:`hunting.describe.mechanical`).
+
+    Examples
+    --------
+    >>> d = {"parameters": {"m": 95.0, "cm": 35.15, "Fc": 20.0, "b": 200.0, "kp": 3.9e4, "kd": 243.0,
+    ...                     "r": 0.0},
+    ...      "states": ["q", "v"], "signals": {"u": "-kp*(q - r) - kd*v"},
+    ...      "equations": {"q": "v", "v": "(cm*u - F)/m"},
+    ...      "friction": {"force": "F", "velocity": "v", "model": "switch",
+    ...                   "slip": "sign(w)*Fc + b*w", "stick": "Fc"}}
+    >>> nominal_from_description(d).to_dict()["controller"]
+    {'type': 'pid', 'kp': 39000.0, 'kd': 243.0, 'ki': 0.0, 'derivative_on': 'measurement'}
+    """
+    from ..describe.mechanical import mechanical_parameters
+    if isinstance(description, (str, Path)):
+        from ..describe import read_description
+        description = read_description(description)
+    return nominal_from_parameters(mechanical_parameters(description, **overrides))
+
+
+def nominal_from_parameters(p) -> NominalModel:
+    """The :class:`NominalModel` of parameters read off a description
+    (:func:`hunting.describe.mechanical.mechanical_parameters`, exact or an error naming the part
+    that has no reading):
+
+    - friction: ``switch`` with Fs = Fc in both directions is the law ``coulomb-viscous``, otherwise
+      ``switch`` (a Stribeck dip); ``lugre`` is ``lugre`` with its sigma0 and sigma1;
+    - controller: ``{"type": "pid", "kp", "kd", "ki"}`` with ``"tau_f"`` for a derivative filter and
+      ``"derivative_on": "measurement"`` when the reference enters the P and I terms only; the data's
+      ``q_ref`` column is the reference (the description's reference parameter or signal is only its
+      placeholder), ``"saturation"`` for a ``min(max(.., -S), S)`` limit, and the controller is
+      updated every data sample (a description is continuous);
+    - cogging: the harmonics read off the velocity equation, as functions of the description's
+      position state (which is the data's q column);
+    - what a description cannot say stays at the nominal model's defaults: no delay, flexibility,
+      frictional lag or dwell, sample time, and the sensor's resolution read from the data.
+    """
+    if p.law == "lugre":
+        law = "lugre"
+    else:
+        flat = all(c.Fs == c.Fc for c in (p.curve.positive, p.curve.negative))
+        law = "coulomb-viscous" if flat else "switch"
+    ctrl = None
+    if p.controller is not None:
+        c = p.controller
+        ctrl = {"type": "pid", "kp": c.kp, "kd": c.kd, "ki": c.ki}
+        if c.tau_f:
+            ctrl["tau_f"] = c.tau_f
+        if c.derivative_on != "error":
+            ctrl["derivative_on"] = c.derivative_on
+        if math.isfinite(c.saturation):
+            ctrl["saturation"] = c.saturation
+    model = NominalModel(p.mass, p.cm, p.curve, law, offset=p.offset, sigma0=p.sigma0, sigma1=p.sigma1,
+                         controller=ctrl, cogging=() if p.cogging is None else (p.cogging,))
+    return model.replace()
