@@ -493,3 +493,14 @@ def test_the_worse_resimulation_note_reaches_the_report(monkeypatch):
     assert [c.name for c in dg.causes] == ["offset"]
     assert any("re-simulates the validation run worse" in n for n in dg.notes), dg.notes
     assert "re-simulates the validation run worse" in format_terminal(dg)
+
+
+def test_an_offset_the_data_lack_is_said_so():
+    """A model with a 3 N constant force on data without one: the finding is that the model's
+    force is not there, not 'a constant force of 1.08 mN pushes the load' (reviewer, 2026-11-23)."""
+    from hunting.diagnose.causes import offset
+    m = NominalModel.from_dict({"plant": {"mass": 95.0, "motor_constant": 35.15, "offset": 3.0},
+                                "friction": {"Fc": 20.0, "b": 200.0}})
+    said = offset.sentence({"offset": 0.00108}, {"offset": -2.99892}, m)
+    assert said.startswith("the model's constant force of 3 N is not in the data") and "pushes" not in said
+    assert "pushes the load towards negative" in offset.sentence({"offset": 1.5}, {"offset": -1.5}, m)

@@ -26,6 +26,10 @@ def extend(model, theta, hyper):
 
 
 def sentence(p, inc, model) -> str:
+    if model.offset and abs(p["offset"]) < 0.05 * abs(model.offset):
+        # the finding is that the model's constant force is not there, not the tiny rest
+        return (f"the model's constant force of {_q(abs(model.offset), None, 'N')} is not in the data (what remains "
+                f"of it is {_q(p['offset'], None, 'N')}, less than 5 % of it)")
     side = "negative" if p["offset"] > 0 else "positive"
     return (f"a constant force of {_q(abs(p['offset']), None, 'N')} pushes the load towards {side} positions "
             f"(the model has {_q(model.offset, None, 'N') if model.offset else 'none'}; a Coulomb level differing by twice that between the "
