@@ -107,13 +107,8 @@ def test_position_noise_is_read_from_unquantized_positions():
 
 def _saturation_p(u):
     """The saturation judge's p-value of an output u alone (both tests of the null)."""
-    from hunting.diagnose.causes.saturation import coinciding_peaks
-    p = p_value(*pile_up(u)[2:])
-    same, others, p0 = coinciding_peaks(u)
-    if others:
-        p_same = stats.binom.sf(same - 1, others, p0) if same >= 1 else 1.0
-        p = min(1.0, 2 * min(p, p_same))
-    return p
+    from hunting.diagnose.causes.saturation import evidence
+    return evidence(u)[3]
 
 
 def test_saturation_touched_one_sample_at_a_time_is_evidence():

@@ -72,10 +72,7 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
     N = y0.size
     out_t, out_x, out_m = np.empty(1), np.empty((1, N)), np.empty(1, dtype=np.int64)
     cap = max_events + 1
-    ev_t, ev_xb, ev_xa = np.empty(cap), np.empty((cap, n)), np.empty((cap, n))
-    ev_g, ev_f, ev_to = (np.empty(cap, dtype=np.int64) for _ in range(3))
-    info = np.zeros(K.N_INFO, dtype=np.int64)
-    finfo = np.zeros(K.N_FINFO)
+    ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo = K.event_buffers(cap, n)
     yf = np.empty(N)
     jac = system.jacobian if system.jacobian is not None else no_jacobian
     nf, ni = K.workspace_sizes(N, n, system.n_guards, system.n_modes, 50)

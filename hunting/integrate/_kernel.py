@@ -315,6 +315,15 @@ KERNEL_SIG = types.void(
 )
 
 
+def event_buffers(cap: int, n: int) -> tuple:
+    """(ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo): the event log for ``cap`` events of
+    an n-state system and the kernel's status arrays, as integrate_kernel takes them (Python
+    callers; the batch kernel allocates its own inside numba)."""
+    return (np.empty(cap), np.empty((cap, n)), np.empty((cap, n)), np.empty(cap, dtype=np.int64),
+            np.empty(cap, dtype=np.int64), np.empty(cap, dtype=np.int64), np.zeros(N_INFO, dtype=np.int64),
+            np.zeros(N_FINFO))
+
+
 @numba.njit(cache=True)
 def workspace_sizes(n, nb, ng, n_modes, zeno_count):
     """Sizes (float, int) of the workspaces integrate_kernel needs (callable from Python and numba)."""

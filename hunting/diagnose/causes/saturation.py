@@ -104,15 +104,24 @@ def p_value(hits: int, misses: int) -> float:
     return float(stats.binom.sf(hits - 1, hits + misses, 0.5)) if hits >= 1 else 1.0
 
 
-def judge(fit, validate, kf, kv, model, can_sim, resolution):
-    from ..resimulate import position_rms_error
-    U, top, hits, misses = pile_up(fit.u)
+def evidence(u: np.ndarray) -> tuple[float, int, int, float]:
+    """(bound |u|, samples at it, hits, p-value) of a bound in the controller output u (n,): the
+    plateau test (:func:`pile_up`, :func:`p_value`) and, for an output that is not quantized, the
+    coinciding-peaks test (:func:`coinciding_peaks`) of the same null, the smaller p doubled
+    (Bonferroni); hits: the larger count of the two."""
+    U, top, hits, misses = pile_up(u)
     p = p_value(hits, misses)
-    same, others, p0 = coinciding_peaks(fit.u)
-    if others:                          # two tests of one null: the smaller p, doubled (Bonferroni)
+    same, others, p0 = coinciding_peaks(u)
+    if others:
         p_same = float(stats.binom.sf(same - 1, others, p0)) if same >= 1 else 1.0
         p = min(1.0, 2 * min(p, p_same))
         hits = max(hits, same)
+    return U, top, hits, p
+
+
+def judge(fit, validate, kf, kv, model, can_sim, resolution):
+    from ..resimulate import position_rms_error
+    U, top, hits, p = evidence(fit.u)
     out = dict(statistic=float(hits), p_value=p)
     if top < MIN_AT_BOUND or U <= 0:
         return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its extreme)")
