@@ -18,7 +18,8 @@ extra tuning directory with its own seed stream, judged together with ``tuning``
 datasets); ``reporting2`` (a never-seen reporting set: ``reporting``'s counts with every cause of
 ``draw.ALL_CAUSES``, the level effect in proportion); ``reporting3`` (the same plan on a new
 stream: ``reporting2`` judged hunting-35f352b and was then looked at, so the verdict on what
-changed after it, tuned on ``tuning`` only, needs data no one has seen).
+changed after it, tuned on ``tuning`` only, needs data no one has seen); ``reporting4`` (the
+same plan on stream 7, for the verdict after ``reporting3`` was looked at).
 
     python -m benchmarks.blind.generate tuning /work/wt/blind-data/tuning
     python -m benchmarks.blind.generate tuning-level /work/wt/blind-data/tuning-level
@@ -37,14 +38,17 @@ import numpy as np
 from . import draw, measures, programme
 from .system import Sensor, nominal_json, run
 
-FAMILIES = {"tuning": 1, "reporting": 2, "test": 3, "tuning-level": 4, "reporting2": 5, "reporting3": 6}
+FAMILIES = {"tuning": 1, "reporting": 2, "test": 3, "tuning-level": 4, "reporting2": 5, "reporting3": 6,
+            "reporting4": 7}
 # (clean, single effect, two effects)
 SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0), "tuning-level": (0, 24, 0),
-         "reporting2": (120, 224, 112), "reporting3": (120, 224, 112)}
+         "reporting2": (120, 224, 112), "reporting3": (120, 224, 112),
+         "reporting4": (120, 224, 112)}
 # the causes each family draws its effects from (the families drawn before ``level`` existed keep
 # their list: their datasets are a function of it)
 FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.CAUSES, "tuning-level": ("level",),
-                 "reporting2": draw.ALL_CAUSES, "reporting3": draw.ALL_CAUSES}
+                 "reporting2": draw.ALL_CAUSES, "reporting3": draw.ALL_CAUSES,
+                 "reporting4": draw.ALL_CAUSES}
 # the tests' subset: short records, the strong half of the size range, ten causes
 SHORT = ("test",)
 TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
