@@ -95,7 +95,27 @@ def test_single_effect_is_named_first_with_its_final_parameters(case):
     if case == "reversal":
         assert c.parameters["sigma0"] == pytest.approx(1e5, rel=0.3)
         assert 0.7 < c.parameters["scale"] < 1.2            # the whole level builds up after a reversal
+        assert ext["friction"].get("sigma1") == pytest.approx(c.parameters["sigma1"], rel=1e-12)
     assert all(s is not None and s > 0 for k, s in c.sigma.items() if k not in ("scale",)), c.sigma
+
+
+@pytest.mark.parametrize("zeta", [0.3])
+def test_reversal_refines_the_bristle_damping_with_the_stiffness(zeta):
+    """LuGre bristles whose presliding resonance is damped at a ratio other than the search's
+    0.5: the refinement frees the damping, so sigma0 is not biased by it and sigma1 is the
+    truth's (with the damping ratio held at 0.5, sigma0 was 26 % low). Detection limit kept as
+    it is: on this loop a contact damped at 0.7 or more is not found (the search holds 0.5;
+    searching three ratios put a reversal on a clean blind tuning dataset)."""
+    import numpy as np
+    base = TruePlant()
+    true = replace(base, sigma0=1e5, sigma1=2 * zeta * np.sqrt(1e5 * base.mass))
+    dg = _run(true)
+    c = dg.causes[0]
+    assert c.name == "reversal"
+    assert c.parameters["sigma0"] == pytest.approx(1e5, rel=0.1)        # the issue's 10 %
+    assert c.parameters["sigma1"] == pytest.approx(true.sigma1, rel=0.15)
+    assert c.parameters["zeta"] == pytest.approx(zeta, rel=0.15)
+    assert c.sigma["sigma1"] > 0
 
 
 @pytest.mark.parametrize("pair", [("offset", "cogging"), ("offset", "asymmetry")])

@@ -551,6 +551,17 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
 
     X, s = design(members)
     theta, cov, rss, _ = gls(X, lib.y_thin - s, run, noise) if X.shape[1] else (np.zeros(0), np.zeros((0, 0)), 0.0, 0)
+    # a cause may offer other starting values of hyper-parameters the search held fixed
+    # (``refine_starts``: the reversal's bristle damping); the best fitting physical one is kept
+    for m, (name, j) in enumerate(list(members)):
+        starts = getattr(CAUSES[name], "refine_starts", None)
+        for h in (starts(lib.variants[name][j].hyper) if starts else []):
+            lib.variants[name].append(lib.variant(name, h))
+            trial = members[:m] + [(name, len(lib.variants[name]) - 1)] + members[m + 1:]
+            Xt, st = design(trial)
+            tt, ct, rt, _ = gls(Xt, lib.y_thin - st, run, noise)
+            if rt < rss and not _unphysical(lib, trial, tt):
+                members, X, s, theta, cov, rss = trial, Xt, st, tt, ct, rt
     for _ in range(iterations if keys else 0):
         G = sensitivities(members, theta)
         th_aug, _, _, _ = gls(np.column_stack([X, G]), lib.y_thin - s, run, noise)

@@ -387,6 +387,9 @@ def _force_channel(lib, model, sel, min_gain: float) -> dict:
     causes = []
     for name, hyper, th, pars, sig, inc, _ in rows:
         sig.update(hyper_sigma.get(name, {}))
+        derived = getattr(CAUSES[name], "derived_sigma", None)
+        if derived is not None:             # parameters computed from refined hyper-parameters
+            sig.update(derived(pars, sig))
         t = sel["tests"][name]
         causes.append(Cause(name, t["gain"], t["t"], t["p_value"], pars, sig,
                             dict(metric="force residual RMS [N], validation", nominal=t["rms_without"],

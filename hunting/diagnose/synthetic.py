@@ -54,6 +54,7 @@ class TruePlant:
     stroke_speed: tuple = (0.05, 0.15)   # range of the strokes' mean speeds [m/s]
     stroke: float = 0.2              # longest stroke [m]
     sigma0: float = 0.0              # LuGre bristle stiffness [N/m] (0: static friction with exact stick)
+    sigma1: float | None = None      # LuGre bristle damping [N s/m] (None: damping ratio 0.5 on sigma0)
 
 
 def bang_bang(fs: float, duration: float, stroke: float = 0.2, seed: int = 0, rest=(0.2, 0.2),
@@ -97,7 +98,7 @@ def true_model(true: TruePlant) -> NominalModel:
         ctrl["output_resolution"] = true.dac_step
     dwell = Dwell(0.0, true.dwell_gain, true.dwell_time) if true.dwell_gain else None
     law = "lugre" if true.sigma0 else ("stribeck" if dip else "coulomb-viscous")
-    s1 = bristle_damping(true.sigma0, true.mass) if true.sigma0 else None
+    s1 = (bristle_damping(true.sigma0, true.mass) if true.sigma1 is None else true.sigma1) if true.sigma0 else None
     return NominalModel(true.mass, true.cm, curve, law, offset=true.offset, controller=ctrl, cogging=cog,
                         delay=true.delay, lag=true.lag, dwell=dwell, sigma0=true.sigma0 or None, sigma1=s1)
 

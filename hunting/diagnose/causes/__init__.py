@@ -9,7 +9,9 @@ returning why a fitted theta is not the physical effect (the cause is then rejec
 optionally ``shift(kin, model, hyper)``: the known, unfitted part (n,) [N] of the extension's
 force change (e.g. the nominal Stribeck dip moved to a new vs). Also: ``FAMILY`` (causes that share
 a signature share it), ``HYPERS`` (continuous hyper-parameters searched, counted in BIC),
-``HYPER_KEYS`` (those refined by Gauss-Newton), ``UNITS`` (of the parameters), ``sentence(p,
+``HYPER_KEYS`` (those refined by Gauss-Newton; optionally ``derived_sigma(parameters, sigma)``
+giving the standard uncertainty of parameters computed from them, and ``refine_starts(hyper)``:
+other starting values of hyper-parameters the search holds fixed), ``UNITS`` (of the parameters), ``sentence(p,
 increments, model)`` (the finding in words), ``untestable(kin, model)`` (why a record cannot test
 it), ``EXCLUDES`` (causes it cannot be combined with), ``NOISE_FED`` (its regressor is made of
 measured derivatives: judged also along a noise-free instrument trajectory). Adding a cause is
