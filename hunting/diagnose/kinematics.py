@@ -41,7 +41,8 @@ class Kinematics:
     the filter edges and from stops and break-aways by half a window); vf [m/s] : short-window velocity for the friction maps; a_inst [m/s^2] :
     second differences of q; drive [N] : cm u (aligned for the zero-order hold) + f_ext; slide :
     bool, the mass slides (not stuck); resolution, noise [m] : the position sensor's step and
-    noise (standard deviation before quantization)."""
+    noise (standard deviation before quantization); held [N] : cm u as sampled (each value held
+    over the interval after it), for the delayed drive (None: ``drive`` is all there is)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -57,15 +58,35 @@ class Kinematics:
     slide: np.ndarray
     resolution: float = 0.0
     noise: float = 0.0
+    held: np.ndarray | None = None
 
     @property
     def dt(self) -> float:
         return float(self.t[1] - self.t[0])
 
     def delayed_drive(self, delay: float) -> np.ndarray:
-        """The drive [N] (n,) delayed by ``delay`` [s] >= 0: linear interpolation of the
-        ZOH-aligned drive (exact for whole samples), held at its first value before it starts."""
-        return np.interp(self.t - delay, self.t, self.drive) if delay > 0 else self.drive
+        """The drive [N] (n,) with its held part cm u delayed by ``delay`` [s] >= 0, as the second
+        difference of the position sees it: the zero-order-held staircase shifted by delay =
+        (j + f) dt, weighted by the second difference's triangular kernel, is
+        f^2/2 u[k-j-2] + (1/2 + f - f^2) u[k-j-1] + (1/2 - f + f^2/2) u[k-j] (exact for any
+        delay; linear interpolation of the aligned drive is exact only for whole samples: 0.4 of
+        a random walk's step off at fractional delays), held at the first value before the record
+        starts; f_ext is not delayed."""
+        if not delay > 0:
+            return self.drive
+        if self.held is None:
+            return np.interp(self.t - delay, self.t, self.drive)
+        x = delay / self.dt
+        j = int(np.floor(x))
+        f = x - j
+        n = self.held.size
+        idx = np.arange(n)
+
+        def back(m):
+            return self.held[np.clip(idx - m, 0, n - 1)]
+        aligned = np.concatenate([[self.held[0]], 0.5 * (self.held[1:] + self.held[:-1])])
+        delayed = 0.5 * f * f * back(j + 2) + (0.5 + f - f * f) * back(j + 1) + (0.5 - f + 0.5 * f * f) * back(j)
+        return self.drive - aligned + delayed
 
     def filtered(self, x: np.ndarray) -> np.ndarray:
         """H_a x for x (n,) or (n, k): the filter the acceleration and the drive force went
@@ -167,7 +188,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     change[1:] = slide[1:] != slide[:-1]
     moving &= edge & ~dilate(change, w // 2)
     return Kinematics(meas.t, q, v, a, force, float(cm), w * dt, moving, vf, a_inst, drive, slide,
-                      float(resolution), float(noise))
+                      float(resolution), float(noise), cm * np.asarray(meas.u, float))
 
 
 def reference_kinematics(meas: Measurement, model, *, window: float | None = None) -> Kinematics | None:
@@ -240,9 +261,9 @@ def map_uncertain(kin: Kinematics, model, r: np.ndarray | None = None) -> np.nda
 
 def residual(kin: Kinematics, model) -> np.ndarray:
     """Force residual r = H_a[g] [N] of a NominalModel (module docstring): the drive delayed by
-    the model's delay exactly (linear interpolation of the ZOH-aligned drive, exact for whole
-    samples; the first-order form cm u - delay cm u' left a residual that a resonance fitted on
-    noise-free records of loops with a two-sample delay)."""
+    the model's delay exactly (:meth:`Kinematics.delayed_drive`; the first-order form
+    cm u - delay cm u' left a residual that a resonance fitted on noise-free records of loops with
+    a two-sample delay)."""
     s = kin.slide
     cog = model.cogging_force(kin.q)
     sliding = model.friction(kin.vf) + model.lag_force(kin.vf, kin.slide, kin.dt)
