@@ -11,8 +11,7 @@ model in its Filippov limit (the mass sticks when its velocity reaches zero and 
 needs, |cm u + f_ext - offset - F_cog| <= Fs of that direction, is available; it slips again when
 not); reversals are located inside a substep by linear interpolation of v. For lugre the bristle
 state z is integrated (F = sigma0 z + sigma1 z' + b v). The plant is integrated with fixed RK4
-substeps between samples (``substeps`` per sample, raised for stiff LuGre bristles so that a
-substep stays below the inverse of their fastest rate: :func:`stiff_substeps`).
+substeps between samples (``substeps`` per sample).
 
 Controllers (the MODEL.json ``controller`` schema):
   {"type": "pid", "form": "PDI", "P", "D", "I"}  u = -P (e + D e' + I int e), e = q - q_ref
@@ -324,28 +323,6 @@ def steps_on_grid(x: np.ndarray, step: float) -> tuple[int, int]:
     return int(np.sum(np.abs(c - np.round(c)) < 0.02)), int(c.size)
 
 
-MAX_SUBSTEPS = 10_000
-RELAX_STEP = 2.0     # h times the bristles' relaxation rate, at most (RK4 is stable up to 2.78 on the real axis)
-RESONANCE_STEP = 0.5  # h times the presliding resonance's rate, at most (its oscillation must be followed)
-
-
-def stiff_substeps(meas: Measurement, model: NominalModel, substeps: int) -> int:
-    """The substeps per sample (at least ``substeps``, at most MAX_SUBSTEPS) that keep a LuGre
-    model's RK4 substep h stable on its bristles' relaxation sigma0 |v| / g at the record's top
-    speed (times 1.2: a re-simulation may overshoot it), h sigma0 |v| / g <= RELAX_STEP, and
-    accurate on the presliding resonance: h max(sqrt(sigma0 / m), sigma1 / m) <= RESONANCE_STEP.
-    At 20 substeps a 4e7 N/m contact of 8 kg sampled at 1.25 ms diverged, and a 1.3e7 N/m one
-    came out 6 times off in its position error without failing."""
-    if model.law != "lugre" or not model.sigma0:
-        return substeps
-    g = min(model.curve.positive.Fc, model.curve.negative.Fc)
-    v_top = 1.2 * float(np.max(np.abs(np.diff(meas.q)))) / meas.dt if meas.n > 1 else 0.0
-    relax = model.sigma0 * v_top / g if g > 0 else 0.0
-    resonance = max(math.sqrt(model.sigma0 / model.mass), (model.sigma1 or 0.0) / model.mass)
-    need = meas.dt * max(relax / RELAX_STEP, resonance / RESONANCE_STEP)
-    return int(min(MAX_SUBSTEPS, max(substeps, math.ceil(need))))
-
-
 def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | None = None,
                substeps: int = 20, resolution: float | None = None, force_noise=None, x0=None, sensor_noise: float | None = None,
                seed: int = 0) -> Simulation:
@@ -409,7 +386,6 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
         x[:3] = x0
         x[3] = 1.0 if (x0[1] == 0.0 and model.law != "lugre") else 0.0
     n = meas.n
-    substeps = stiff_substeps(meas, model, int(substeps))
     qo, uo, vo, so = np.empty(n), np.empty(n), np.empty(n), np.zeros(n, np.bool_)
     delay_sub = int(round(model.delay / (dt / substeps)))
     sn = model.sensor_noise if sensor_noise is None else check_finite_positive("sensor_noise", sensor_noise,

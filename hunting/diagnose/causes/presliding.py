@@ -32,7 +32,7 @@ DESCRIPTION = "finite stick stiffness: motion while |F| < Fs (LuGre sigma0)"
 CHANNEL = "stick"
 FAMILY = "bristles"
 UNITS = {"sigma0": "N/m", "sigma1": "N s/m"}
-ZETA = 0.5                   # the damping ratio of the presliding resonance
+ZETA = 0.5
 
 
 def friction_force(kin, model) -> np.ndarray:
@@ -151,10 +151,10 @@ def fit_behaviour(meas, model, *, max_evals: int = 14) -> tuple[np.ndarray, floa
     return np.array([10.0 ** -best]), cache[best]
 
 
-def bristle_damping(sigma0: float, mass: float, zeta: float = ZETA) -> float:
-    """sigma1 [N s/m] at damping ratio ``zeta`` (default ZETA) of the presliding resonance of
-    ``mass`` [kg] on ``sigma0`` [N/m]."""
-    return float(np.sqrt(sigma0 * mass)) * 2 * zeta
+def bristle_damping(sigma0: float, mass: float) -> float:
+    """sigma1 [N s/m] at damping ratio ZETA of the presliding resonance of ``mass`` [kg] on
+    ``sigma0`` [N/m]: what creeping data cannot determine."""
+    return float(np.sqrt(sigma0 * mass)) * 2 * ZETA
 
 
 def parameters(theta, hyper, model) -> dict:
