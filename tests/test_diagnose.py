@@ -504,3 +504,35 @@ def test_an_offset_the_data_lack_is_said_so():
     said = offset.sentence({"offset": 0.00108}, {"offset": -2.99892}, m)
     assert said.startswith("the model's constant force of 3 N is not in the data") and "pushes" not in said
     assert "pushes the load towards negative" in offset.sentence({"offset": 1.5}, {"offset": -1.5}, m)
+
+
+def test_a_cogging_the_data_lack_is_said_so_with_the_merged_harmonics():
+    """A model with a 2 N cogging on data without one: the cause's amplitudes are the merged
+    harmonics (the model's plus the fitted change: about 0, not the 2 N component cancelling the
+    model's), the extended model holds them in place of the model's component, the change is
+    the extra field, and the sentence says the model's cogging is not in the data (it said 'a
+    force periodic in position that the model lacks ... 2 N'; reviewer's finding)."""
+    from hunting.diagnose.causes import cogging
+    from hunting.models.plant import Cogging
+    true = TruePlant()
+    nominal = NominalModel.from_dict(NOMINAL).replace(cogging=(Cogging.sine(2.0, 0.012),))
+    dg = _run(true, nominal=nominal, causes=["cogging", "offset"])
+    assert [c.name for c in dg.causes] == ["cogging"]
+    c = dg.causes[0]
+    assert c.parameters["amplitude_1"] < 0.1 and c.increments["amplitude_1"] == pytest.approx(-2.0, abs=0.1)
+    held = dg.extended_model.cogging
+    assert len(held) == 1 and held[0].period == c.parameters["pitch"]
+    for k in range(cogging.HARMONICS):
+        assert np.hypot(held[0].data[2 * k], held[0].data[2 * k + 1]) == pytest.approx(c.parameters[f"amplitude_{k + 1}"],
+                                                                                       rel=1e-12, abs=1e-15)
+    from hunting.diagnose.report import finding
+    said = finding(dg, c)
+    assert said.startswith("the model's force periodic in position (pitch 12 mm, first harmonic 2 N) is not in the data")
+    assert "lacks" not in format_terminal(dg)
+    # a cogging the model has at the wrong size: the final amplitude, and the model's beside it
+    m = nominal.replace(cogging=(Cogging.harmonic(0.012, cos=[0.0, 0.3], sin=[2.0]),))
+    theta = np.array([0.0, 1.5, -0.1, 0.0, 0.2, 0.0])
+    p = cogging.parameters(theta, {"pitch": 0.012}, m)
+    assert p["amplitude_1"] == pytest.approx(3.5) and p["amplitude_2"] == pytest.approx(np.hypot(0.2, 0.0))
+    assert cogging.extend(m, theta, {"pitch": 0.012}).cogging[0].data[:4] == pytest.approx((0.0, 3.5, 0.2, 0.0))
+    assert "first harmonic 3.5 N (the model's 2 N)" in cogging.sentence(p, {}, m)
