@@ -536,3 +536,29 @@ def test_a_cogging_the_data_lack_is_said_so_with_the_merged_harmonics():
     assert p["amplitude_1"] == pytest.approx(3.5) and p["amplitude_2"] == pytest.approx(np.hypot(0.2, 0.0))
     assert cogging.extend(m, theta, {"pitch": 0.012}).cogging[0].data[:4] == pytest.approx((0.0, 3.5, 0.2, 0.0))
     assert "first harmonic 3.5 N (the model's 2 N)" in cogging.sentence(p, {}, m)
+
+
+def test_a_rejected_reversal_quotes_no_ratio_over_a_change_that_does_not_show():
+    """At the stiffest bristles searched LuGre's build-up is over within a sample, its regressor
+    is near zero (1e-11 N) and the fitted scale on clean data is 1e8 or more: the rejection said
+    '-1.1e12 times LuGre's' (reviewer). A large scale is not quoted, a negative one is said to
+    have the opposite sign, a small one keeps its ratio."""
+    import re
+    from hunting.diagnose.causes import reversal
+    from hunting.diagnose.kinematics import residual
+    true = TruePlant()
+    m = true_model(true).replace(controller=None)
+    meas = generate(true, 4.0, seed=1)
+    kin = kinematics(meas, m.cm, window=31 * meas.dt)
+    r = residual(kin, m)
+    ok = kin.moving & np.isfinite(r)
+    h = reversal.hypers(kin, m)[-1]
+    x = reversal.design(kin, m, h)[:, 0]
+    scale = float(np.dot(x[ok], r[ok]) / np.dot(x[ok], x[ok]))
+    assert abs(scale) > 1e4                                  # the meaningless ratio the old text quoted
+    for k in (scale, -scale, -1.1e12, 5e3):
+        why = reversal.unphysical([k], h, m)
+        assert why and not re.search(r"-?\d[\d.]*(e[+-]?\d+)? times", why.replace("10 times", "")), why
+    assert "opposite sign" in reversal.unphysical([-0.5], h, m)
+    assert "0.04 times LuGre's" in reversal.unphysical([0.04], h, m)
+    assert reversal.unphysical([1.0], h, m) is None
