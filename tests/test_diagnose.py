@@ -492,7 +492,11 @@ def test_the_worse_resimulation_note_reaches_the_report(monkeypatch):
     dg = _run(true, nominal=nominal, duration=6.0, behaviour=True, causes=["offset"])
     assert [c.name for c in dg.causes] == ["offset"]
     assert any("re-simulates the validation run worse" in n for n in dg.notes), dg.notes
-    assert "re-simulates the validation run worse" in format_terminal(dg)
+    text = format_terminal(dg)
+    assert "re-simulates the validation run worse" in text
+    # where a reader sees it: right under the findings, before the tables and the rule (it came
+    # at the end, after the tables and the rejected and untested causes)
+    assert text.index("1. offset:") < text.index("note: ") < text.index("Validation data") < text.index("Rule:")
 
 
 def test_an_offset_the_data_lack_is_said_so():
