@@ -566,3 +566,28 @@ def test_a_rejected_reversal_quotes_no_ratio_over_a_change_that_does_not_show():
     assert "opposite sign" in reversal.unphysical([-0.5], h, m)
     assert "0.04 times LuGre's" in reversal.unphysical([0.04], h, m)
     assert reversal.unphysical([1.0], h, m) is None
+
+
+def test_a_model_saturation_below_the_measured_output_is_said_first():
+    """A model saturating at 1.5 V on a loop whose output reaches 4.7 V: that was only a '27 %
+    controller mismatch' note, printed after the rule (reviewer's finding). Now the first note
+    gives both numbers, the mismatch note says the saturation is what differs, the notes come
+    right under the findings, and the saturation cause holds the measured level, the value the
+    extended model's controller holds. The true model (saturation 10 V, never reached) gets
+    no such note."""
+    from hunting.diagnose.guards import check_saturation
+    true = TruePlant()
+    fit, val = generate(true, 12.0, seed=1), generate(true, 12.0, seed=2)
+    model = true_model(true)
+    assert check_saturation((fit, val), model) is None
+    low = model.replace(controller=dict(model.controller, saturation=1.5))
+    dg = diagnose(fit, low, val)
+    top = float(max(np.max(np.abs(fit.u)), np.max(np.abs(val.u))))
+    assert dg.notes[0].startswith(f"{val.name}: the measured controller output reaches |u| = {top:.4g}, ")
+    assert "the model's saturation level 1.5 " in dg.notes[0]
+    assert any("without its saturation at 1.5 it is 0.0%" in n for n in dg.notes), dg.notes
+    c = {c.name: c for c in dg.causes}["saturation"]
+    assert c.parameters["saturation"] == top == dg.extended_model.controller["saturation"]
+    assert c.increments["saturation"] == pytest.approx(top - 1.5)
+    text = format_terminal(dg)
+    assert text.index("note: ") < text.index("Validation data") < text.index("Rule:")
