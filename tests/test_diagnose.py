@@ -591,3 +591,9 @@ def test_a_model_saturation_below_the_measured_output_is_said_first():
     assert c.increments["saturation"] == pytest.approx(top - 1.5)
     text = format_terminal(dg)
     assert text.index("note: ") < text.index("Validation data") < text.index("Rule:")
+    # at 2 V only the validation record goes beyond: the note, and the cause says why it is not judged
+    from hunting.diagnose.causes import saturation
+    at2 = model.replace(controller=dict(model.controller, saturation=2.0))
+    assert check_saturation((fit, val), at2).startswith(f"{val.name}: the measured controller output reaches")
+    why = saturation.judge(fit, val, None, None, at2, True, 1e-6)["reason"]
+    assert why.startswith("the fitting data stay within the model's saturation level 2 (max |u| 1.94")

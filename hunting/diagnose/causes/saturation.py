@@ -163,6 +163,9 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         # each record sets, not a fitted value (the fitting record's alone left the extended model
         # clipping the validation run at 1.94 where it reached 4.67)
         U = max(U, float(np.max(np.abs(validate.u))))
+    elif beyond(validate.u, sat)[1] >= MIN_AT_BOUND:
+        return dict(out, reason=f"the fitting data stay within the model's saturation level {sat:.4g} (max |u| {U:.4g}); "
+                                "the validation data go beyond it (see the note), which cannot set a level it is judged on")
     elif top < MIN_AT_BOUND or U <= 0:
         return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its extreme)")
     elif abs(sat - U) <= 0.01 * U:
