@@ -38,9 +38,11 @@ def _emps_dir():
     pytest.skip("EMPS data not found (set HUNTING_DATA to the directory holding emps/)")
 
 
-def test_clean_data_gives_no_cause():
+def test_clean_data_gives_no_cause(tmp_path):
     """The true model with its controller on clean data: no cause in any channel, the behaviour
-    view re-simulated, and the terminal report says so in words with units and no None."""
+    view re-simulated, and the terminal report says so in words with units and no None; the
+    HTML page too, its units as written (str.capitalize made '172 mN RMS' '172 mn rms')."""
+    from hunting.diagnose.report import write_report
     true = TruePlant()
     dg = _run(true, nominal=true_model(true), behaviour=True)
     assert dg.causes == []
@@ -48,6 +50,8 @@ def test_clean_data_gives_no_cause():
     text = format_terminal(dg)
     assert "no cause found" in text and "None" not in text and "Rule:" in text
     assert "µm" in text or " m " in text                 # values carry units
+    page = write_report(dg, tmp_path).read_text()
+    assert "<p>No cause found: " in page and "mN RMS" in page and " rms" not in page
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.0035])

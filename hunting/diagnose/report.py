@@ -135,6 +135,12 @@ def no_cause_headline(dg: Diagnosis) -> str:
     return f"no cause found: no cause passed the rule; the nominal model's validation force residual is {size}"
 
 
+def _sentence_case(text: str) -> str:
+    """The first letter upper case, the rest as written (str.capitalize turned '172 mN RMS' into
+    '172 mn rms')."""
+    return text[:1].upper() + text[1:]
+
+
 def _reason(r: dict) -> str:
     if r.get("reason"):
         return r["reason"]
@@ -275,7 +281,7 @@ def write_report(dg: Diagnosis, directory) -> Path:
     finds = "".join(f"<li>{html.escape(c.name)}: {html.escape(finding(dg, c))}</li>" for c in dg.causes)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>hunting diagnosis</title></head><body>
 <h1>Diagnosis</h1>
-{'<ul>' + finds + '</ul>' if finds else '<p>' + html.escape(no_cause_headline(dg).capitalize()) + '.</p>'}
+{'<ul>' + finds + '</ul>' if finds else '<p>' + html.escape(_sentence_case(no_cause_headline(dg))) + '.</p>'}
 {'<h2>Notes</h2><ul>' + notes + '</ul>' if notes else ''}
 <table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
 <th>validation metric: nominal → extended</th></tr>{rows}</table>
