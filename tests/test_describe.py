@@ -610,3 +610,22 @@ def test_example_files_load_and_run(path):
     m = hunting.load_model(path)
     tr = hunting.simulate(m.system, m.state(), (0.0, 0.5), method="radau", rtol=1e-8, atol=1e-12)
     assert tr.success and m.description["name"] == m.name
+
+
+@pytest.mark.parametrize("desc, label", [
+    (_with(friction__colour=1), "friction['friction'] (switch) keys ['colour']"),
+    (_with(friction__model="coulomb"), "friction['friction'].model"),
+    (_with(friction__stick=None), "friction['friction'] (switch) needs 'stick'"),
+    (_with(friction__name="2nd"), "friction['friction'].name = '2nd' must be an identifier"),
+    (_with(friction__velocity="vb"), "friction['friction'].velocity"),
+    (_with(friction__name="belt", friction__colour=1), "friction['belt'] (switch) keys"),
+    (dict(_with(), friction=[_with()["friction"], "F2"]), "friction['friction2'] = 'F2' must be a mapping"),
+])
+def test_contact_errors_name_the_contact_one_way(desc, label):
+    """Every description error names a contact friction['<name>'] (its name or the default of its
+    place), the structural checks too: they said friction[0] where the later ones said
+    friction['friction'] for the same contact (reviewer's finding)."""
+    with pytest.raises(hunting.SystemDefinitionError) as e:
+        hunting.model(desc)
+    assert str(e.value).startswith(label), str(e.value)
+    assert "friction[0]" not in str(e.value) and "friction[1]" not in str(e.value)

@@ -38,9 +38,11 @@ def _emps_dir():
     pytest.skip("EMPS data not found (set HUNTING_DATA to the directory holding emps/)")
 
 
-def test_clean_data_gives_no_cause():
+def test_clean_data_gives_no_cause(tmp_path):
     """The true model with its controller on clean data: no cause in any channel, the behaviour
-    view re-simulated, and the terminal report says so in words with units and no None."""
+    view re-simulated, and the terminal report says so in words with units and no None; the
+    HTML page too, its units as written (str.capitalize made '172 mN RMS' '172 mn rms')."""
+    from hunting.diagnose.report import write_report
     true = TruePlant()
     dg = _run(true, nominal=true_model(true), behaviour=True)
     assert dg.causes == []
@@ -48,6 +50,8 @@ def test_clean_data_gives_no_cause():
     text = format_terminal(dg)
     assert "no cause found" in text and "None" not in text and "Rule:" in text
     assert "µm" in text or " m " in text                 # values carry units
+    page = write_report(dg, tmp_path).read_text()
+    assert "<p>No cause found: " in page and "mN RMS" in page and " rms" not in page
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.0035])
@@ -512,7 +516,11 @@ def test_the_worse_resimulation_note_reaches_the_report(monkeypatch):
     dg = _run(true, nominal=nominal, duration=6.0, behaviour=True, causes=["offset"])
     assert [c.name for c in dg.causes] == ["offset"]
     assert any("re-simulates the validation run worse" in n for n in dg.notes), dg.notes
-    assert "re-simulates the validation run worse" in format_terminal(dg)
+    text = format_terminal(dg)
+    assert "re-simulates the validation run worse" in text
+    # where a reader sees it: right under the findings, before the tables and the rule (it came
+    # at the end, after the tables and the rejected and untested causes)
+    assert text.index("1. offset:") < text.index("note: ") < text.index("Validation data") < text.index("Rule:")
 
 
 def test_an_offset_the_data_lack_is_said_so():
@@ -524,3 +532,92 @@ def test_an_offset_the_data_lack_is_said_so():
     said = offset.sentence({"offset": 0.00108}, {"offset": -2.99892}, m)
     assert said.startswith("the model's constant force of 3 N is not in the data") and "pushes" not in said
     assert "pushes the load towards negative" in offset.sentence({"offset": 1.5}, {"offset": -1.5}, m)
+
+
+def test_a_cogging_the_data_lack_is_said_so_with_the_merged_harmonics():
+    """A model with a 2 N cogging on data without one: the cause's amplitudes are the merged
+    harmonics (the model's plus the fitted change: about 0, not the 2 N component cancelling the
+    model's), the extended model holds them in place of the model's component, the change is
+    the extra field, and the sentence says the model's cogging is not in the data (it said 'a
+    force periodic in position that the model lacks ... 2 N'; reviewer's finding)."""
+    from hunting.diagnose.causes import cogging
+    from hunting.models.plant import Cogging
+    true = TruePlant()
+    nominal = NominalModel.from_dict(NOMINAL).replace(cogging=(Cogging.sine(2.0, 0.012),))
+    dg = _run(true, nominal=nominal, causes=["cogging", "offset"])
+    assert [c.name for c in dg.causes] == ["cogging"]
+    c = dg.causes[0]
+    assert c.parameters["amplitude_1"] < 0.1 and c.increments["amplitude_1"] == pytest.approx(-2.0, abs=0.1)
+    held = dg.extended_model.cogging
+    assert len(held) == 1 and held[0].period == c.parameters["pitch"]
+    for k in range(cogging.HARMONICS):
+        assert np.hypot(held[0].data[2 * k], held[0].data[2 * k + 1]) == pytest.approx(c.parameters[f"amplitude_{k + 1}"],
+                                                                                       rel=1e-12, abs=1e-15)
+    from hunting.diagnose.report import finding
+    said = finding(dg, c)
+    assert said.startswith("the model's force periodic in position (pitch 12 mm, first harmonic 2 N) is not in the data")
+    assert "lacks" not in format_terminal(dg)
+    # a cogging the model has at the wrong size: the final amplitude, and the model's beside it
+    m = nominal.replace(cogging=(Cogging.harmonic(0.012, cos=[0.0, 0.3], sin=[2.0]),))
+    theta = np.array([0.0, 1.5, -0.1, 0.0, 0.2, 0.0])
+    p = cogging.parameters(theta, {"pitch": 0.012}, m)
+    assert p["amplitude_1"] == pytest.approx(3.5) and p["amplitude_2"] == pytest.approx(np.hypot(0.2, 0.0))
+    assert cogging.extend(m, theta, {"pitch": 0.012}).cogging[0].data[:4] == pytest.approx((0.0, 3.5, 0.2, 0.0))
+    assert "first harmonic 3.5 N (the model's 2 N)" in cogging.sentence(p, {}, m)
+
+
+def test_a_rejected_reversal_quotes_no_ratio_over_a_change_that_does_not_show():
+    """At the stiffest bristles searched LuGre's build-up is over within a sample, its regressor
+    is near zero (1e-11 N) and the fitted scale on clean data is 1e8 or more: the rejection said
+    '-1.1e12 times LuGre's' (reviewer). A large scale is not quoted, a negative one is said to
+    have the opposite sign, a small one keeps its ratio."""
+    import re
+    from hunting.diagnose.causes import reversal
+    from hunting.diagnose.kinematics import residual
+    true = TruePlant()
+    m = true_model(true).replace(controller=None)
+    meas = generate(true, 4.0, seed=1)
+    kin = kinematics(meas, m.cm, window=31 * meas.dt)
+    r = residual(kin, m)
+    ok = kin.moving & np.isfinite(r)
+    h = reversal.hypers(kin, m)[-1]
+    x = reversal.design(kin, m, h)[:, 0]
+    scale = float(np.dot(x[ok], r[ok]) / np.dot(x[ok], x[ok]))
+    assert abs(scale) > 1e4                                  # the meaningless ratio the old text quoted
+    for k in (scale, -scale, -1.1e12, 5e3):
+        why = reversal.unphysical([k], h, m)
+        assert why and not re.search(r"-?\d[\d.]*(e[+-]?\d+)? times", why.replace("10 times", "")), why
+    assert "opposite sign" in reversal.unphysical([-0.5], h, m)
+    assert "0.04 times LuGre's" in reversal.unphysical([0.04], h, m)
+    assert reversal.unphysical([1.0], h, m) is None
+
+
+def test_a_model_saturation_below_the_measured_output_is_said_first():
+    """A model saturating at 1.5 V on a loop whose output reaches 4.7 V: that was only a '27 %
+    controller mismatch' note, printed after the rule (reviewer's finding). Now the first note
+    gives both numbers, the mismatch note says the saturation is what differs, the notes come
+    right under the findings, and the saturation cause holds the measured level, the value the
+    extended model's controller holds. The true model (saturation 10 V, never reached) gets
+    no such note."""
+    from hunting.diagnose.guards import check_saturation
+    true = TruePlant()
+    fit, val = generate(true, 12.0, seed=1), generate(true, 12.0, seed=2)
+    model = true_model(true)
+    assert check_saturation((fit, val), model) is None
+    low = model.replace(controller=dict(model.controller, saturation=1.5))
+    dg = diagnose(fit, low, val)
+    top = float(max(np.max(np.abs(fit.u)), np.max(np.abs(val.u))))
+    assert dg.notes[0].startswith(f"{val.name}: the measured controller output reaches |u| = {top:.4g}, ")
+    assert "the model's saturation level 1.5 " in dg.notes[0]
+    assert any("without its saturation at 1.5 it is 0.0%" in n for n in dg.notes), dg.notes
+    c = {c.name: c for c in dg.causes}["saturation"]
+    assert c.parameters["saturation"] == top == dg.extended_model.controller["saturation"]
+    assert c.increments["saturation"] == pytest.approx(top - 1.5)
+    text = format_terminal(dg)
+    assert text.index("note: ") < text.index("Validation data") < text.index("Rule:")
+    # at 2 V only the validation record goes beyond: the note, and the cause says why it is not judged
+    from hunting.diagnose.causes import saturation
+    at2 = model.replace(controller=dict(model.controller, saturation=2.0))
+    assert check_saturation((fit, val), at2).startswith(f"{val.name}: the measured controller output reaches")
+    why = saturation.judge(fit, val, None, None, at2, True, 1e-6)["reason"]
+    assert why.startswith("the fitting data stay within the model's saturation level 2 (max |u| 1.94")

@@ -77,9 +77,33 @@ def check_controller(meas: Measurement, model: NominalModel) -> str | None:
         return None
     keys = "kp/kv/sample_time" if model.controller.get("type") == "pd-velocity-loop" else \
         "kp/kd/ki/derivative_on/tau_f/sample_time"
-    return (f"{meas.name}: the model's controller fed the measured q and q_ref gives u with {mismatch:.0%} RMS "
-            f"mismatch to the measured u (more than {CONTROLLER_MISMATCH:.0%}): check the controller's {keys} and "
-            "the sign and unit of u; re-simulations run a loop the machine did not")
+    text = (f"{meas.name}: the model's controller fed the measured q and q_ref gives u with {mismatch:.0%} RMS "
+            f"mismatch to the measured u (more than {CONTROLLER_MISMATCH:.0%})")
+    if math.isfinite(model.controller.get("saturation", math.inf)):
+        free = controller_output(meas, {k: v for k, v in model.controller.items() if k != "saturation"})
+        rest = float(np.sqrt(np.mean((free - meas.u) ** 2))) / size
+        if rest <= CONTROLLER_MISMATCH:
+            return (f"{text}; without its saturation at {model.controller['saturation']:.4g} it is {rest:.1%}: the "
+                    "saturation is what differs, and re-simulations clip u where the machine did not")
+    return f"{text}: check the controller's {keys} and the sign and unit of u; re-simulations run a loop the machine did not"
+
+
+def check_saturation(records, model: NominalModel) -> str | None:
+    """A note when a record's measured controller output goes beyond the model's saturation level
+    (:func:`hunting.diagnose.causes.saturation.beyond`, at least MIN_AT_BOUND samples), with both
+    numbers: the model's controller cannot give those outputs, so its level is wrong or the
+    machine's controller has none (None otherwise, or without a saturation in the model)."""
+    from .causes.saturation import MIN_AT_BOUND, beyond, model_level
+    level = model_level(model)
+    if not (math.isfinite(level) and level > 0):
+        return None
+    found = [(beyond(m.u, level), m.name) for m in records]
+    (U, above), name = max(found, key=lambda f: f[0][0])
+    if above < MIN_AT_BOUND:
+        return None
+    return (f"{name}: the measured controller output reaches |u| = {U:.4g}, {U / level:.3g} times the model's saturation "
+            f"level {level:.4g} (in u's unit; {above} samples beyond it): the model's controller cannot give that, so its "
+            "saturation is wrong or the machine's controller has none; re-simulations clip u where the machine did not")
 
 
 SAME_DATA_NOTE = ("the validation data are the fitting data ({}): the out-of-sample test then runs on the fitting data "

@@ -49,8 +49,9 @@ def _p_text(p) -> str:
 def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
     """The diagnosis as the ``hunting diagnose`` command prints it: what the simulation gets
     wrong (one sentence per finding), each cause's final parameters with units and standard
-    uncertainties and its validation gain, the validation metrics nominal against extended, the
-    alternatives, the rejected and the untested causes with their reasons, and the rule."""
+    uncertainties and its validation gain, the notes (right under the findings, where they are
+    read), the validation metrics nominal against extended, the alternatives, the rejected and the
+    untested causes with their reasons, and the rule."""
     import textwrap
 
     def wrap(text, indent="  ", sub="    "):
@@ -70,6 +71,9 @@ def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
                             "     ", "       "))
     else:
         out.append(no_cause_headline(dg) + ".")
+    if dg.notes:                 # what the reader must know before the tables: right under the findings
+        out.append("")
+        out.extend(wrap(f"note: {n}", "", "  ") for n in dg.notes)
     rows = []
     for g in dg.gains():
         label = g["metric"] if "measured" not in g else (
@@ -107,9 +111,6 @@ def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
         out.append("Not tested on these data:")
         for u in dg.untested:
             out.append(wrap(f"{u['name']}: {u['reason']}"))
-    if dg.notes:
-        out.append("")
-        out.extend(wrap(f"note: {n}", "", "  ") for n in dg.notes)
     out.append("")
     out.append(wrap(f"Rule: {dg.criterion}.", "", "  "))
     return "\n".join(out)
@@ -132,6 +133,12 @@ def no_cause_headline(dg: Diagnosis) -> str:
     size = f"{_q(dg.nominal, None, 'N')} RMS" + (f", {_pct(dg.nominal / drive)} of the drive force's RMS"
                                                  if drive > 0 else "")
     return f"no cause found: no cause passed the rule; the nominal model's validation force residual is {size}"
+
+
+def _sentence_case(text: str) -> str:
+    """The first letter upper case, the rest as written (str.capitalize turned '172 mN RMS' into
+    '172 mn rms')."""
+    return text[:1].upper() + text[1:]
 
 
 def _reason(r: dict) -> str:
@@ -274,15 +281,15 @@ def write_report(dg: Diagnosis, directory) -> Path:
     finds = "".join(f"<li>{html.escape(c.name)}: {html.escape(finding(dg, c))}</li>" for c in dg.causes)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>hunting diagnosis</title></head><body>
 <h1>Diagnosis</h1>
-<table border="1" cellpadding="4"><tr><th>validation metric</th><th>measured</th><th>nominal</th><th>extended</th></tr>{gains}</table>
-{'<ul>' + notes + '</ul>' if notes else ''}
-<p>Rule: {html.escape(dg.criterion)}.</p>
+{'<ul>' + finds + '</ul>' if finds else '<p>' + html.escape(_sentence_case(no_cause_headline(dg))) + '.</p>'}
+{'<h2>Notes</h2><ul>' + notes + '</ul>' if notes else ''}
 <table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
 <th>validation metric: nominal → extended</th></tr>{rows}</table>
-{'<ul>' + finds + '</ul>' if finds else '<p>' + html.escape(no_cause_headline(dg).capitalize()) + '.</p>'}
+<table border="1" cellpadding="4"><tr><th>validation metric</th><th>measured</th><th>nominal</th><th>extended</th></tr>{gains}</table>
 {'<h2>Alternatives</h2><ul>' + alt + '</ul>' if alt else ''}
 {'<h2>Tested and rejected (why)</h2><ul>' + rej + '</ul>' if rej else ''}
 {'<h2>Not tested on these data (why)</h2><ul>' + unt + '</ul>' if unt else ''}
+<p>Rule: {html.escape(dg.criterion)}.</p>
 {''.join(f'<img src="{i}" width="720"><br>' for i in imgs)}</body></html>"""
     (d / "index.html").write_text(page)
     return d / "index.html"

@@ -173,7 +173,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .force import Library, select
-    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_units, same_record
+    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_saturation, check_units, same_record
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -192,6 +192,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if same:
         notes.append(SAME_DATA_NOTE.format(validate.name))
     notes += [n for n in (check_controller(m, model) for m in ((fit,) if same else (fit, validate))) if n]
+    beyond = check_saturation((fit,) if same else (fit, validate), model)
+    if beyond:                                       # a plain fact about the model: said first
+        notes.insert(0, beyond)
     if window is None:
         window = default_window(fit, validate, model)
     sensor = dict(resolution=model.resolution, noise=model.sensor_noise)

@@ -1,8 +1,16 @@
 """A force periodic in position (cogging of magnets, a screw's lead error): three harmonics of a
-spatial period found from the residual's Lomb-Scargle spectrum against position."""
+spatial period found from the residual's Lomb-Scargle spectrum against position.
+
+When the model has a harmonic cogging of about that pitch (within ``MATCH``), the cause corrects
+it rather than adding a second one: its parameters are the merged harmonics (the model's plus the
+fitted change, harmonic by harmonic), the component the extended model holds in place of the
+model's at the fitted pitch; the model's higher harmonics (beyond ``HARMONICS``) stay at its own
+pitch. The fitted coefficients theta are the change of the model's coefficients; the model's
+coefficients moved from its pitch to the fitted one are the known, unfitted part of the force
+change (``shift``: zero when the pitches agree)."""
 import numpy as np
 
-from ...models.plant import Cogging
+from ...models.plant import COG_HARMONIC, Cogging
 from ._words import _q
 
 NAME = "cogging"
@@ -12,6 +20,32 @@ HYPERS = 1
 HYPER_KEYS = ("pitch",)
 UNITS = {"pitch": "m", "amplitude_1": "N", "amplitude_2": "N", "amplitude_3": "N"}
 HARMONICS = 3
+MATCH = 0.03          # a model cogging within 3 % of the pitch is the one corrected (the pitch grid's half width)
+GONE = 0.05           # merged amplitude below 5 % of the model's: the model's cogging is not in the data (as offset)
+
+
+def matched(model, pitch: float) -> int | None:
+    """Index in ``model.cogging`` of the harmonic component whose period is nearest ``pitch`` [m]
+    and within MATCH of it (None: the model has no cogging of that pitch)."""
+    best = None
+    for i, c in enumerate(model.cogging):
+        if c.kind != COG_HARMONIC:
+            continue
+        d = abs(c.period / pitch - 1.0)
+        if d <= MATCH and (best is None or d < best[0]):
+            best = (d, i)
+    return None if best is None else best[1]
+
+
+def model_coefficients(model, pitch: float) -> np.ndarray:
+    """The matched component's first HARMONICS coefficients (cos_1, sin_1, cos_2, ..) [N] (2 HARMONICS,),
+    zeros without a match."""
+    out = np.zeros(2 * HARMONICS)
+    i = matched(model, pitch)
+    if i is not None:
+        d = np.asarray(model.cogging[i].data, dtype=float)[:2 * HARMONICS]
+        out[:d.size] = d
+    return out
 
 
 def hypers(kin, model) -> list:
@@ -80,18 +114,61 @@ def design(kin, model, hyper):
     return kin.sliding(_harmonics(kin.q, hyper["pitch"]))
 
 
+def shift(kin, model, hyper) -> np.ndarray:
+    """The model's matched harmonics moved from its pitch to the fitted one [N] (n,): zero
+    without a match or at the model's own pitch."""
+    i = matched(model, hyper["pitch"])
+    if i is None:
+        return np.zeros(kin.t.size)
+    c0 = model_coefficients(model, hyper["pitch"])
+    moved = _harmonics(kin.q, hyper["pitch"]) @ c0 - _harmonics(kin.q, model.cogging[i].period) @ c0
+    return kin.sliding(moved)
+
+
+def merged(theta, hyper, model) -> np.ndarray:
+    """The final coefficients (cos_1, sin_1, ..) [N] (2 HARMONICS,) at the fitted pitch: the
+    model's matched ones plus the fitted change."""
+    return model_coefficients(model, hyper["pitch"]) + np.asarray(theta, dtype=float)
+
+
 def parameters(theta, hyper, model) -> dict:
-    amp = [float(np.hypot(theta[2 * k], theta[2 * k + 1])) for k in range(HARMONICS)]
+    c = merged(theta, hyper, model)
     out = {"pitch": hyper["pitch"]}
-    out.update({f"amplitude_{k + 1}": a for k, a in enumerate(amp)})
+    out.update({f"amplitude_{k + 1}": float(np.hypot(c[2 * k], c[2 * k + 1])) for k in range(HARMONICS)})
     return out
 
 
 def extend(model, theta, hyper):
-    comp = Cogging.harmonic(hyper["pitch"], cos=list(theta[0::2]), sin=list(theta[1::2]))
-    return model.replace(cogging=model.cogging + (comp,))
+    c = merged(theta, hyper, model)
+    comp = Cogging.harmonic(hyper["pitch"], cos=list(c[0::2]), sin=list(c[1::2]))
+    i = matched(model, hyper["pitch"])
+    if i is None:
+        return model.replace(cogging=model.cogging + (comp,))
+    old = model.cogging[i]
+    rest = list(model.cogging[:i]) + [comp] + list(model.cogging[i + 1:])
+    if old.n > HARMONICS:        # the model's higher harmonics stay at its pitch
+        d = [0.0] * (2 * HARMONICS) + list(old.data[2 * HARMONICS:])
+        rest.append(Cogging.harmonic(old.period, cos=d[0::2], sin=d[1::2]))
+    return model.replace(cogging=tuple(rest))
+
+
+def _size(a) -> float:
+    return float(np.sqrt(np.sum(np.square(a))))
 
 
 def sentence(p, inc, model) -> str:
-    return (f"a force periodic in position that the model lacks: pitch {_q(p['pitch'], None, 'm')}, "
-            f"first harmonic {_q(p['amplitude_1'], None, 'N')}")
+    pitch, amp = p["pitch"], [p[f"amplitude_{k + 1}"] for k in range(HARMONICS)]
+    i = matched(model, pitch)
+    if i is None:
+        return (f"a force periodic in position that the model lacks: pitch {_q(pitch, None, 'm')}, "
+                f"first harmonic {_q(amp[0], None, 'N')}")
+    c0 = model_coefficients(model, pitch)
+    amp0 = np.hypot(c0[0::2], c0[1::2])
+    if _size(amp) < GONE * _size(amp0):
+        # the finding is that the model's cogging is not there, not the component cancelling it
+        return (f"the model's force periodic in position (pitch {_q(model.cogging[i].period, None, 'm')}, first "
+                f"harmonic {_q(amp0[0], None, 'N')}) is not in the data (what remains of it is "
+                f"{_q(_size(amp), None, 'N')} over its harmonics, less than {100 * GONE:.0f} % of it)")
+    return (f"the force periodic in position differs from the model's: pitch {_q(pitch, None, 'm')} (the model's "
+            f"{_q(model.cogging[i].period, None, 'm')}), first harmonic {_q(amp[0], None, 'N')} (the model's "
+            f"{_q(amp0[0], None, 'N')})")

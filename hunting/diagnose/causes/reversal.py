@@ -105,13 +105,33 @@ def design(kin, model, hyper):
     return kin.sliding(s0 * z + s1 * zdot - np.sign(v) * g)[:, None]
 
 
+RATIO_SHOWN = 10.0     # fitted scales above this are not quoted: LuGre's change there is too small to compare with
+
+
 def unphysical(theta, hyper, model) -> str | None:
+    """Why a fitted ``scale`` outside SCALE_RANGE is not LuGre's build-up (None inside it). The
+    scale is the fitted change over LuGre's, quoted only between 0 and RATIO_SHOWN: a negative one
+    has the opposite sign (no ratio to quote), and a large one comes from a LuGre change that
+    hardly shows at this sigma0 (a build-up over a slip shorter than a sample's travel: its
+    regressor is near zero and the ratio, e.g. -1.1e12, means nothing)."""
     lo, hi = SCALE_RANGE
-    if not lo <= theta[0] <= hi:
-        return (f"the friction change after reversals is {theta[0]:.2f} times LuGre's (sigma0 = {hyper['sigma0']:.3g} "
-                f"N/m); LuGre builds up the whole level (1; accepted {lo:g}..{hi:g}): a friction deficit near "
-                "reversals of another kind")
-    return None
+    k = float(theta[0])
+    if lo <= k <= hi:
+        return None
+    at = f"sigma0 = {_q(hyper['sigma0'], None, 'N/m')}"
+    tail = f"LuGre builds up the whole level (scale 1; accepted {lo:g}..{hi:g}): a friction change near reversals of another kind"
+    if k < 0:
+        return (f"the friction change after reversals has the opposite sign of LuGre's build-up ({at}: more friction "
+                f"right after reversals, not less); {tail}")
+    if k > RATIO_SHOWN:
+        return (f"the friction change after reversals is more than {RATIO_SHOWN:g} times LuGre's at {at}, whose "
+                f"build-up (over a slip of about {_q(_slip(hyper, model), None, 'm')}) hardly shows in these data; {tail}")
+    return f"the friction change after reversals is {k:.2f} times LuGre's ({at}); {tail}"
+
+
+def _slip(hyper, model) -> float:
+    """Fc / sigma0 [m]: the slip over which LuGre's friction builds up."""
+    return min(model.curve.positive.Fc, model.curve.negative.Fc) / hyper["sigma0"]
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -133,6 +153,5 @@ def extend(model, theta, hyper):
 
 
 def sentence(p, inc, model) -> str:
-    Fc = min(model.curve.positive.Fc, model.curve.negative.Fc)
-    return (f"after each velocity reversal friction builds up over a slip of about {_q(Fc / p['sigma0'], None, 'm')} "
+    return (f"after each velocity reversal friction builds up over a slip of about {_q(_slip(p, model), None, 'm')} "
             f"instead of jumping (LuGre bristles, sigma0 = {_q(p['sigma0'], None, 'N/m')})")

@@ -18,7 +18,13 @@ height within 1e-6 with shapes of their own, which sampled smooth peaks do with 
 at most about 3 % each, while an output that touches a bound for one sample at a time does
 so again and again (the smaller p of the two, doubled). The extension is the controller's ``saturation`` at the
 measured bound; its gain is the fall of the re-simulated position RMS error on the validation
-data (needs the controller and the reference)."""
+data (needs the controller and the reference).
+
+A model whose saturation level the measured output goes beyond (:func:`beyond`: by more than 1 %
+of it and two output steps) is wrong whatever the pile-up test says: the model's controller
+cannot give those outputs. That is the evidence then (p = 0), and the extension's level the
+largest measured |u| (the machine's limit, if it has one, is at least there); the diagnosis also
+says it first among its notes (:func:`hunting.diagnose.guards.check_saturation`)."""
 import numpy as np
 from scipy import stats
 
@@ -119,24 +125,68 @@ def evidence(u: np.ndarray) -> tuple[float, int, int, float]:
     return U, top, hits, p
 
 
+BEYOND = 0.01          # measured |u| above the model's level by more than 1 % of it (and two output steps) is beyond it
+
+
+def model_level(model) -> float:
+    """The model controller's saturation level (inf without one or without a controller)."""
+    return float(model.controller.get("saturation", np.inf)) if model.controller else np.inf
+
+
+def beyond(u: np.ndarray, level: float) -> tuple[float, int]:
+    """(max |u|, samples of u (n,) beyond ``level``): above it by more than BEYOND of it and two
+    steps of the output's quantization. The model's controller cannot give those outputs: its
+    saturation is wrong, or the machine's controller has none. (max |u|, 0) for an infinite level."""
+    from ..resimulate import resolution_of
+    a = np.abs(np.asarray(u, dtype=float))
+    U = float(np.max(a)) if a.size else 0.0
+    if not np.isfinite(level):
+        return U, 0
+    tol = max(BEYOND * level, 2 * resolution_of(u))
+    return U, int(np.count_nonzero(a > level + tol))
+
+
 def judge(fit, validate, kf, kv, model, can_sim, resolution):
+    """The evidence: a pile-up at a bound (:func:`evidence`), or outputs of the fitting data
+    beyond the model's saturation level (:func:`beyond`, at least MIN_AT_BOUND samples: a fact,
+    p = 0, the statistic their count). The extension: the saturation at the measured bound, or
+    beyond the model's level at the largest measured |u| of both records (the final value; its
+    change against the model's level the increment)."""
     from ..resimulate import position_rms_error
     U, top, hits, p = evidence(fit.u)
     out = dict(statistic=float(hits), p_value=p)
-    if top < MIN_AT_BOUND or U <= 0:
+    sat = model_level(model)
+    _, above = beyond(fit.u, sat)
+    if above >= MIN_AT_BOUND:
+        out = dict(statistic=float(above), p_value=0.0)
+        # the machine's output reaches at least the largest |u| of either record: a lower bound
+        # each record sets, not a fitted value (the fitting record's alone left the extended model
+        # clipping the validation run at 1.94 where it reached 4.67)
+        U = max(U, float(np.max(np.abs(validate.u))))
+    elif beyond(validate.u, sat)[1] >= MIN_AT_BOUND:
+        return dict(out, reason=f"the fitting data stay within the model's saturation level {sat:.4g} (max |u| {U:.4g}); "
+                                "the validation data go beyond it (see the note), which cannot set a level it is judged on")
+    elif top < MIN_AT_BOUND or U <= 0:
         return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its extreme)")
-    sat = model.controller.get("saturation", np.inf) if model.controller else np.inf
-    if abs(sat - U) <= 0.01 * U:
+    elif abs(sat - U) <= 0.01 * U:
         return dict(out, reason=f"the model already saturates at {sat:.4g}")
     if not can_sim:
         return dict(out, reason="the gain needs re-simulation: the model's controller and the reference q_ref", untestable=True)
     ext = model.replace(controller=dict(model.controller, saturation=U))
     return dict(out, parameters={"saturation": U}, sigma={"saturation": None},
+                increments={"saturation": U - sat} if np.isfinite(sat) else {},
                 metric="re-simulated position RMS error [m], validation", nominal=position_rms_error(validate, model),
                 extended=position_rms_error(validate, ext),
                 model=ext)
 
 
 def sentence(p, inc, model) -> str:
-    return (f"the controller output saturates at ±{p['saturation']:.4g} (in u's unit), which the model's controller "
+    U, S = p["saturation"], model_level(model)
+    if np.isfinite(S) and U > S:
+        return (f"the controller output reaches ±{U:.4g} (in u's unit), beyond the model's saturation at ±{S:.4g}: the "
+                "model's controller limits it where the machine's does not (its level is wrong, or the machine's "
+                "controller has none)")
+    if np.isfinite(S):
+        return f"the controller output saturates at ±{U:.4g} (in u's unit), below the model's saturation at ±{S:.4g}"
+    return (f"the controller output saturates at ±{U:.4g} (in u's unit), which the model's controller "
             "does not")
