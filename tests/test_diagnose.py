@@ -621,3 +621,14 @@ def test_a_model_saturation_below_the_measured_output_is_said_first():
     assert check_saturation((fit, val), at2).startswith(f"{val.name}: the measured controller output reaches")
     why = saturation.judge(fit, val, None, None, at2, True, 1e-6)["reason"]
     assert why.startswith("the fitting data stay within the model's saturation level 2 (max |u| 1.94")
+
+
+def test_viscous_sentence_gives_values_not_a_ratio_to_next_to_nothing():
+    """A model viscous coefficient of almost nothing: the sentence gives both values, not a ratio
+    of 1e9 (the reviewer's reversal finding, the same kind in viscous)."""
+    from hunting.diagnose.causes import viscous
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 1.0, "b": 1e-9}})
+    text = viscous.sentence({"b": 5.0}, {"b": 5.0}, model)
+    assert "times" not in text and "5 N s/m" in text
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 1.0, "b": 2.0}})
+    assert "2.5 times the model's" in viscous.sentence({"b": 5.0}, {"b": 3.0}, model)

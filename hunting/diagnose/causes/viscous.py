@@ -10,6 +10,7 @@ FAMILY = "velocity"
 HYPERS = 0
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 UNITS = {"b": "N s/m"}
+RATIO_WORDS = 10.0     # larger changes are given as the two values, not as a ratio
 
 
 def hypers(kin, model) -> list:
@@ -38,5 +39,8 @@ def sentence(p, inc, model) -> str:
     if not b0:
         return f"viscous friction that the model lacks (b = {_q(p['b'], None, 'N s/m')}; the model has none)"
     ratio = p["b"] / b0
+    if not 0 < ratio <= RATIO_WORDS:       # a ratio to a next-to-nothing model value says nothing
+        return (f"viscous friction of b = {_q(p['b'], None, 'N s/m')}, where the model has "
+                f"{_q(b0, None, 'N s/m')}")
     return (f"viscous friction is {ratio:.3g} times the model's (b = {_q(p['b'], None, 'N s/m')} instead of "
             f"{_q(b0, None, 'N s/m')})")
