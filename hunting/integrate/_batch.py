@@ -58,7 +58,7 @@ def batch_kernel(kernel, vf, guards, reset, jac, mode_of, has_jac, method,
     n = X0.shape[1]
     n_modes = directions.shape[0]
     ng = directions.shape[1]
-    nf, ni = K.workspace_sizes(n, n, ng, n_modes, 50)
+    nf, ni = K.workspace_sizes(n, n, ng, n_modes, np.int64(50))   # int64, not Literal[int](50): one compile
     wf = np.empty(nf)
     wi = np.empty(ni, dtype=np.int64)
     # copies of the shared arrays per call (per thread): reference counting on one array from
