@@ -529,7 +529,7 @@ def _make_kernel(full_flag):
 
         if record_steps and not use_eval and n_out == 0:
             out_t[0] = t
-            _put_row(out_x, 0, x)
+            _put_row(out_x, n_out, x)   # n_out == 0 here; a literal 0 compiled _put_row a second time
             out_mode[0] = mode
             n_out = 1
         while use_eval and i_eval < n_eval and t_eval[i_eval] <= t:
