@@ -19,6 +19,16 @@ functions they compile in turn). For the user model (examples/pid_lugre.json: PI
 Measured (2 shared cores, CPU seconds, lowest of 2-3 cold runs; before -> after the change that
 compiles the servo functions on first use, inlines only DOP853 into the lean kernel and takes
 the batch's work arrays from the caller): see docs/architecture.md, "Kernel structure".
+
+Latest (cold CPU [s], lowest of 2, main and the branch with the forceinline helpers run in
+alternation, 2026-11-23; the machine's noise is +-2 s, so read the compile column):
+
+    scenario        main            branch          lean kernel's own compile
+    simulate        15.2 / 18.2     15.6 / 15.9     8.0 / 8.7 -> 7.7 / 7.2
+    eventmap        17.6 / 19.7     16.2 / 17.6     7.6 / 9.5 -> 6.6 / 7.2
+    user model      14.7 / 17.9     16.0 / 16.2     7.2 / 9.4 -> 7.3 / 6.8
+    reproduce ch9   23.6-25.5       22.4-26.2       7.6-9.9   -> 6.1-8.7 (medians 8.1 -> 7.1)
+    (warm ch9: 7.6-9.9 s CPU on both)
 """
 from __future__ import annotations
 
