@@ -305,3 +305,15 @@ def test_blind_subset_parameters_within_10_percent(blind_subset):
 def test_blind_subset_parameters_target(blind_subset):
     rows, s = blind_subset
     assert s["params"][0] >= report.TARGETS["params"], _bad_parameters(rows)
+
+
+def test_peer_reports_nothing_on_a_record_that_does_not_move():
+    """The peer on a record with no sliding samples (reporting4's d0427 raised an IndexError in its
+    library): no cause at any threshold, not an exception."""
+    from benchmarks.blind import measures, peer
+    t = np.arange(2000) * 1e-3
+    kin = measures.Kin(t, np.zeros_like(t), 0.1 * np.sin(t), 1.0)
+    nominal = Plant(mass=1.0, cm=1.0, pos=Curve(1.0, 1.0), neg=Curve(1.0, 1.0))
+    out = peer.fit(kin, nominal)
+    assert set(out["thresholds"]) == {f"{th:.6g}" for th in peer.THRESHOLDS}
+    assert all(v["causes"] == [] for v in out["thresholds"].values())

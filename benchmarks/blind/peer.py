@@ -38,6 +38,7 @@ from . import measures
 from .system import Curve, Plant
 
 THRESHOLDS = tuple(float(x) for x in np.geomspace(0.01, 1.0, 31))
+MIN_MOVING = 50       # samples away from rest a regression needs (fewer: the peer reports nothing)
 RIDGE = 1e-2          # ridge penalty per sample (columns have unit RMS): steadies collinear terms
 SLIPS = (2e-6, 1e-5, 5e-5)
 
@@ -156,6 +157,10 @@ def fit(kin: measures.Kin, nominal: Plant) -> dict:
     import pysindy as ps
     r = measures.residual(kin, nominal)
     mv = _away_from_rest(kin)
+    if min(np.count_nonzero(kin.moving), np.count_nonzero(mv)) < MIN_MOVING:
+        # a record that hardly moves has no sliding samples to regress on (it raised an
+        # IndexError on reporting4's d0427): nothing to report, as sparse regression would say
+        return dict(thresholds={f"{th:.6g}": dict(causes=[]) for th in THRESHOLDS}, pitch=None, frequency=None)
     Theta, names, hyper = library(kin, nominal, r)
     X = Theta[mv]
     y = r[mv]
