@@ -632,3 +632,16 @@ def test_viscous_sentence_gives_values_not_a_ratio_to_next_to_nothing():
     assert "times" not in text and "5 N s/m" in text
     model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 1.0, "b": 2.0}})
     assert "2.5 times the model's" in viscous.sentence({"b": 5.0}, {"b": 3.0}, model)
+
+
+def test_presliding_stiffer_than_the_sensor_can_see_is_no_presliding():
+    """A stick-channel fit that runs to the stiffest contact whose presliding range Fs / sigma0
+    is half the encoder's step is rejected (a Stribeck change on a blind tuning record was
+    taken for 1.7e8 N/m bristles, a 0.1 um range, once the re-simulation followed them)."""
+    from hunting.diagnose.causes import presliding
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 10.0},
+                                    "sensor": {"resolution": 1e-6}})
+    meas = Measurement(np.arange(100) * 1e-3, np.zeros(100), np.zeros(100))
+    assert presliding.stiffest(model, meas) == pytest.approx(2e7)
+    assert "stiffest contact" in presliding.at_bound(np.array([1 / 2e7]), meas, model)
+    assert presliding.at_bound(np.array([1 / 1e6]), meas, model) is None

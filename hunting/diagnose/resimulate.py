@@ -194,6 +194,42 @@ def _rk4(q, v, z, s, fa, h, p, cog, bases):
             z + h / 6.0 * (c1 + 2 * c2 + 2 * c3 + c4))
 
 
+STIFF_RK4 = 1.0   # h sigma0 |v| / g above which a LuGre substep takes the bristles at steady state (RK4: stable below 2.8)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _bristle_relaxation(v, s, p):
+    """The LuGre bristles' relaxation rate sigma0 |v| / g(v) [1/s] in direction s."""
+    base = 4 if s > 0 else 9
+    g = stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3])
+    return p[14] * abs(v) / g if g > 0.0 else 0.0
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _steady_rates(q, v, s, fa, p, cog, bases):
+    """(q', v') of the loop with the bristles at their steady deflection (F = s g(|v|) + b v)."""
+    base = 4 if s > 0 else 9
+    g = stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3])
+    return v, (fa - _cog(q, cog, bases) - s * g - p[base + 4] * v) / p[0]
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _rk4_steady_bristles(q, v, s, fa, h, p, cog, bases):
+    """One RK4 step of length h of a LuGre loop whose bristles relax within the step (h sigma0
+    |v| / g beyond STIFF_RK4): they are taken at their steady deflection z = s g(|v|) / sigma0,
+    where dz/dt = 0 and the friction is the steady curve (the singular-perturbation limit; its
+    error is the bristles' lag, a fraction 1 / (h sigma0 |v| / g) of the step). Plain RK4 on the
+    bristle state needs h sigma0 |v| / g < 2.8 to stay stable. Returns (q, v, z)."""
+    a1, b1 = _steady_rates(q, v, s, fa, p, cog, bases)
+    a2, b2 = _steady_rates(q + 0.5 * h * a1, v + 0.5 * h * b1, s, fa, p, cog, bases)
+    a3, b3 = _steady_rates(q + 0.5 * h * a2, v + 0.5 * h * b2, s, fa, p, cog, bases)
+    a4, b4 = _steady_rates(q + h * a3, v + h * b3, s, fa, p, cog, bases)
+    qn = q + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+    vn = v + h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+    base = 4 if s > 0 else 9
+    return qn, vn, s * stribeck_level(s * vn, p[base], p[base + 1], p[base + 2], p[base + 3]) / p[14]
+
+
 @numba.njit(cache=True, error_model="numpy", nogil=True)
 def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
           v_out, stuck_out):
@@ -223,7 +259,11 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
             ua = u_init if j < 0 else u_out[j // substeps]
             fa = p[1] * ua + fext[k] - p[2]
             if lugre:
-                q, v, z = _rk4(q, v, z, 1.0 if v >= 0.0 else -1.0, fa, h, p, cog, bases)
+                s = 1.0 if v >= 0.0 else -1.0
+                if h * _bristle_relaxation(v, s, p) <= STIFF_RK4:
+                    q, v, z = _rk4(q, v, z, s, fa, h, p, cog, bases)
+                else:
+                    q, v, z = _rk4_steady_bristles(q, v, s, fa, h, p, cog, bases)
                 continue
             rem = h
             for _ in range(3):             # a substep holds at most a stop and a restart

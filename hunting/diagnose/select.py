@@ -493,6 +493,9 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     if p >= alpha:
         return reject(reason="no motion beyond quantization and sensor noise where the model sticks")
     theta = mod.fit_behaviour(fit, model)[0] if can_sim else mod.fit_quasistatic(kf, model, segs)
+    why = mod.at_bound(theta, fit, model) if hasattr(mod, "at_bound") else None
+    if why:
+        return reject(reason=why)
     try:
         ext = mod.extend(model, theta, {})
     except SystemDefinitionError as exc:           # e.g. a negative fitted compliance

@@ -15,7 +15,8 @@ linear in 1/sigma0 (segment offsets free): that fit is used when the controller 
 it is known, sigma0 is fitted on the behaviour instead: the LuGre loop re-simulated from the
 measured reference (with the sensor's quantization and noise, which near rest dither the
 controller output and make a LuGre contact creep) must follow the measured positions; sigma0
-minimizes the position RMS error (golden section on log sigma0, 1e3 .. 1e9 N/m).
+minimizes the position RMS error (golden section on log sigma0, 1e3 N/m up to the stiffest
+contact whose presliding range Fs / sigma0 is half the sensor's step, at most 1e9 N/m).
 
 Evidence: under the nominal model the measured position in the stick segments varies only by
 quantization and sensor noise (variance at most res^2/4 + noise^2); the chi-square of the
@@ -122,10 +123,35 @@ def displacement_rms(kin, model, segs, theta) -> tuple[float, float]:
     return float(np.sqrt(np.mean(r0 ** 2))), float(np.sqrt(np.mean(r1 ** 2)))
 
 
+def stiffest(model, meas) -> float:
+    """The largest sigma0 [N/m] whose presliding the sensor can see: the whole bristle range
+    Fs / sigma0 at half the sensor's step (its resolution, else its noise); 1e9 N/m when the
+    sensor is perfect. A stiffer contact creeps by less than half a count before it breaks away,
+    which no encoder shows as motion where the model sticks: such a fit explains something
+    else (on a blind tuning record a Stribeck change was taken for 1.7e8 N/m bristles, a 0.1 um
+    range, once the re-simulation could follow them)."""
+    from ..resimulate import resolution_of
+    res = model.resolution if model.resolution is not None else resolution_of(meas.q)
+    step = max(res or 0.0, model.sensor_noise or 0.0)
+    Fs = max(model.curve.positive.Fs, model.curve.negative.Fs)
+    return float(min(1e9, 2.0 * Fs / step)) if step > 0 and Fs > 0 else 1e9
+
+
+def at_bound(theta, meas, model) -> str | None:
+    """Why a fitted stiffness is no presliding: it sits at :func:`stiffest` (within 5 %), i.e. the
+    data ask for a contact stiffer than any the sensor could see creep; else None."""
+    top = stiffest(model, meas)
+    sigma0 = 1.0 / theta[0] if theta[0] > 0 else float("inf")
+    if sigma0 >= top / 1.05:
+        return (f"the fit runs to the stiffest contact the sensor could see creep (sigma0 = {sigma0:.3g} N/m, a "
+                f"presliding range Fs / sigma0 of half its step): no presliding the data resolve")
+    return None
+
+
 def fit_behaviour(meas, model, *, max_evals: int = 14) -> tuple[np.ndarray, float]:
     """theta = [1 / sigma0] minimizing the position RMS error of the re-simulated LuGre loop on
-    ``meas`` (golden section on log10 sigma0 in [3, 9], bounded by max_evals re-simulations).
-    Returns (theta, the RMS error [m])."""
+    ``meas`` (golden section on log10 sigma0 from 1e3 N/m to :func:`stiffest`, bounded by
+    max_evals re-simulations). Returns (theta, the RMS error [m])."""
     from ..resimulate import resimulate
     cache = {}
 
@@ -135,7 +161,8 @@ def fit_behaviour(meas, model, *, max_evals: int = 14) -> tuple[np.ndarray, floa
             n = sim.q.size
             cache[lg] = float(np.sqrt(np.mean((sim.q - meas.q[:n]) ** 2))) if sim.ok else np.inf
         return cache[lg]
-    grid = np.linspace(3.0, 9.0, 7)
+    top = max(np.log10(stiffest(model, meas)), 4.0)
+    grid = np.linspace(3.0, top, max(3, int(round(top - 3.0)) + 1))
     k = int(np.argmin([cost(g) for g in grid]))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     gr = (np.sqrt(5) - 1) / 2
