@@ -168,13 +168,14 @@ def _cog(q, cog, bases):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _rates(q, v, z, s, fa, p, cog, bases):
+def _rates(q, v, z, s, fa, p, cog, bases, steady):
     """(q', v', z') at applied force fa (cm u + f_ext - offset), direction s for the curve. z is
     LuGre's bristle deflection, or for a static law with frictional memory (lag p[16] > 0) the
-    lagging Stribeck level: z' = (g(|v|) - z) / lag, F = s z + b v."""
+    lagging Stribeck level: z' = (g(|v|) - z) / lag, F = s z + b v. steady: LuGre's bristles at
+    their steady deflection (z' = 0, F = s g(|v|) + b v: the static curve while sliding)."""
     base = 4 if s > 0 else 9
     fd = fa - _cog(q, cog, bases)
-    if p[3] > 0.5:
+    if p[3] > 0.5 and not steady:
         zd, F = lugre_rates(v, z, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4], p[14], p[15], 0.0)
         return v, (fd - F) / p[0], zd
     g = stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3])
@@ -184,12 +185,13 @@ def _rates(q, v, z, s, fa, p, cog, bases):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _rk4(q, v, z, s, fa, h, p, cog, bases):
-    """One classical RK4 step of length h with the friction direction s held."""
-    a1, b1, c1 = _rates(q, v, z, s, fa, p, cog, bases)
-    a2, b2, c2 = _rates(q + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, s, fa, p, cog, bases)
-    a3, b3, c3 = _rates(q + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, s, fa, p, cog, bases)
-    a4, b4, c4 = _rates(q + h * a3, v + h * b3, z + h * c3, s, fa, p, cog, bases)
+def _rk4(q, v, z, s, fa, h, p, cog, bases, steady):
+    """One classical RK4 step of length h with the friction direction s held (steady: as in
+    :func:`_rates`)."""
+    a1, b1, c1 = _rates(q, v, z, s, fa, p, cog, bases, steady)
+    a2, b2, c2 = _rates(q + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, s, fa, p, cog, bases, steady)
+    a3, b3, c3 = _rates(q + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, s, fa, p, cog, bases, steady)
+    a4, b4, c4 = _rates(q + h * a3, v + h * b3, z + h * c3, s, fa, p, cog, bases, steady)
     return (q + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4), v + h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4),
             z + h / 6.0 * (c1 + 2 * c2 + 2 * c3 + c4))
 
@@ -206,26 +208,13 @@ def _bristle_relaxation(v, s, p):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _steady_rates(q, v, s, fa, p, cog, bases):
-    """(q', v') of the loop with the bristles at their steady deflection (F = s g(|v|) + b v)."""
-    base = 4 if s > 0 else 9
-    g = stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3])
-    return v, (fa - _cog(q, cog, bases) - s * g - p[base + 4] * v) / p[0]
-
-
-@numba.njit(cache=True, error_model="numpy")
 def _rk4_steady_bristles(q, v, s, fa, h, p, cog, bases):
     """One RK4 step of length h of a LuGre loop whose bristles relax within the step (h sigma0
     |v| / g beyond STIFF_RK4): they are taken at their steady deflection z = s g(|v|) / sigma0,
     where dz/dt = 0 and the friction is the steady curve (the singular-perturbation limit; its
     error is the bristles' lag, a fraction 1 / (h sigma0 |v| / g) of the step). Plain RK4 on the
     bristle state needs h sigma0 |v| / g < 2.8 to stay stable. Returns (q, v, z)."""
-    a1, b1 = _steady_rates(q, v, s, fa, p, cog, bases)
-    a2, b2 = _steady_rates(q + 0.5 * h * a1, v + 0.5 * h * b1, s, fa, p, cog, bases)
-    a3, b3 = _steady_rates(q + 0.5 * h * a2, v + 0.5 * h * b2, s, fa, p, cog, bases)
-    a4, b4 = _steady_rates(q + h * a3, v + h * b3, s, fa, p, cog, bases)
-    qn = q + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-    vn = v + h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+    qn, vn, _ = _rk4(q, v, 0.0, s, fa, h, p, cog, bases, True)
     base = 4 if s > 0 else 9
     return qn, vn, s * stribeck_level(s * vn, p[base], p[base + 1], p[base + 2], p[base + 3]) / p[14]
 
@@ -261,7 +250,7 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
             if lugre:
                 s = 1.0 if v >= 0.0 else -1.0
                 if h * _bristle_relaxation(v, s, p) <= STIFF_RK4:
-                    q, v, z = _rk4(q, v, z, s, fa, h, p, cog, bases)
+                    q, v, z = _rk4(q, v, z, s, fa, h, p, cog, bases, False)
                 else:
                     q, v, z = _rk4_steady_bristles(q, v, s, fa, h, p, cog, bases)
                 continue
@@ -280,7 +269,7 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                     s = 1.0 if need > 0.0 else -1.0
                 else:
                     s = 1.0 if v > 0.0 else -1.0
-                qn, vn, zn = _rk4(q, v, z, s, fa, rem, p, cog, bases)
+                qn, vn, zn = _rk4(q, v, z, s, fa, rem, p, cog, bases, False)
                 if s * vn > 0.0:
                     q, v, z = qn, vn, zn
                     break
@@ -289,8 +278,8 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                 # steps), then decide stick or slip for the rest of the substep
                 th = s * v / (s * v - s * vn) if s * v - s * vn > 0.0 else 1.0
                 for it in range(5):
-                    qa, va, za = _rk4(q, v, z, s, fa, th * rem, p, cog, bases)
-                    acc = _rates(qa, va, za, s, fa, p, cog, bases)[1]
+                    qa, va, za = _rk4(q, v, z, s, fa, th * rem, p, cog, bases, False)
+                    acc = _rates(qa, va, za, s, fa, p, cog, bases, False)[1]
                     th_new = th - va / (rem * acc) if acc != 0.0 else th
                     if it == 4 or not 0.0 < th_new <= 1.0 or abs(th_new - th) <= 1e-13:
                         break              # (qa, za) is the state at th
