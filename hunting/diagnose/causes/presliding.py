@@ -178,10 +178,10 @@ def fit_behaviour(meas, model, *, max_evals: int = 14) -> tuple[np.ndarray, floa
     return np.array([10.0 ** -best]), cache[best]
 
 
-def bristle_damping(sigma0: float, mass: float) -> float:
-    """sigma1 [N s/m] at damping ratio ZETA of the presliding resonance of ``mass`` [kg] on
-    ``sigma0`` [N/m]: what creeping data cannot determine."""
-    return float(np.sqrt(sigma0 * mass)) * 2 * ZETA
+def bristle_damping(sigma0: float, mass: float, zeta: float = ZETA) -> float:
+    """sigma1 [N s/m] at damping ratio ``zeta`` (default ZETA: what creeping data cannot
+    determine) of the presliding resonance of ``mass`` [kg] on ``sigma0`` [N/m]."""
+    return float(np.sqrt(sigma0 * mass)) * 2 * zeta
 
 
 def parameters(theta, hyper, model) -> dict:

@@ -79,7 +79,7 @@ def hyper_bounds(kin, model) -> dict:
 
 def _sigma1(hyper, model) -> float:
     """sigma1 [N s/m] of the hyper-parameters' damping ratio."""
-    return float(2 * hyper.get("zeta", presliding.ZETA) * np.sqrt(hyper["sigma0"] * model.mass))
+    return presliding.bristle_damping(hyper["sigma0"], model.mass, hyper.get("zeta", presliding.ZETA))
 
 
 def untestable(kin, model) -> str | None:
