@@ -42,7 +42,7 @@ class Kinematics:
     second differences of q; drive [N] : cm u (aligned for the zero-order hold) + f_ext; slide :
     bool, the mass slides (not stuck); resolution, noise [m] : the position sensor's step and
     noise (standard deviation before quantization); held [N] : cm u as sampled (each value held
-    over the interval after it), for the delayed drive (None: ``drive`` is all there is)."""
+    over the interval after it), for the delayed drive."""
 
     t: np.ndarray
     q: np.ndarray
@@ -56,9 +56,9 @@ class Kinematics:
     a_inst: np.ndarray
     drive: np.ndarray
     slide: np.ndarray
+    held: np.ndarray
     resolution: float = 0.0
     noise: float = 0.0
-    held: np.ndarray | None = None
 
     @property
     def dt(self) -> float:
@@ -66,27 +66,14 @@ class Kinematics:
 
     def delayed_drive(self, delay: float) -> np.ndarray:
         """The drive [N] (n,) with its held part cm u delayed by ``delay`` [s] >= 0, as the second
-        difference of the position sees it: the zero-order-held staircase shifted by delay =
-        (j + f) dt, weighted by the second difference's triangular kernel, is
-        f^2/2 u[k-j-2] + (1/2 + f - f^2) u[k-j-1] + (1/2 - f + f^2/2) u[k-j] (exact for any
-        delay; linear interpolation of the aligned drive is exact only for whole samples: 0.4 of
-        a random walk's step off at fractional delays), held at the first value before the record
-        starts; f_ext is not delayed."""
+        difference of the position sees it (:func:`seen_by_second_difference`; exact for any
+        delay: linear interpolation of the aligned drive is exact only for whole samples, 0.4 of
+        a random walk's step off at fractional delays); f_ext is not delayed."""
         if not delay > 0:
             return self.drive
-        if self.held is None:
-            return np.interp(self.t - delay, self.t, self.drive)
-        x = delay / self.dt
-        j = int(np.floor(x))
-        f = x - j
-        n = self.held.size
-        idx = np.arange(n)
-
-        def back(m):
-            return self.held[np.clip(idx - m, 0, n - 1)]
-        aligned = np.concatenate([[self.held[0]], 0.5 * (self.held[1:] + self.held[:-1])])
-        delayed = 0.5 * f * f * back(j + 2) + (0.5 + f - f * f) * back(j + 1) + (0.5 - f + 0.5 * f * f) * back(j)
-        return self.drive - aligned + delayed
+        j = int(np.floor(delay / self.dt))
+        return self.drive - seen_by_second_difference(self.held) + seen_by_second_difference(
+            self.held, j, delay / self.dt - j)
 
     def filtered(self, x: np.ndarray) -> np.ndarray:
         """H_a x for x (n,) or (n, k): the filter the acceleration and the drive force went
@@ -99,6 +86,21 @@ class Kinematics:
         x = np.asarray(x, dtype=float)
         s = self.slide if x.ndim == 1 else self.slide[:, None]
         return self.filtered(np.where(s, x, 0.0))
+
+
+def seen_by_second_difference(held: np.ndarray, j: int = 0, f: float = 0.0) -> np.ndarray:
+    """What the position's second difference at t_k sees of a zero-order-held force held (n,)
+    [N] (value k held over [t_k, t_k+1)) delayed by (j + f) samples, 0 <= f < 1: the staircase
+    under the triangular kernel (dt - |s|) / dt^2 on [t_k - dt, t_k + dt], i.e.
+    f^2/2 held[k-j-2] + (1/2 + f - f^2) held[k-j-1] + (1/2 - f + f^2/2) held[k-j], held at its
+    first value before the record starts. Undelayed (j = f = 0) it is the mean of held[k-1] and
+    held[k]: without that alignment every sampled loop shows a 0.5 T "delay"."""
+    n = held.size
+    idx = np.arange(n)
+
+    def back(m):
+        return held[np.clip(idx - m, 0, n - 1)]
+    return 0.5 * f * f * back(j + 2) + (0.5 + f - f * f) * back(j + 1) + (0.5 - f + 0.5 * f * f) * back(j)
 
 
 def acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
@@ -166,10 +168,9 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     vf = savgol_filter(meas.q, wf, 3, deriv=1, delta=dt, mode="interp")
     a_inst = np.zeros(meas.n)
     a_inst[1:-1] = (meas.q[2:] - 2 * meas.q[1:-1] + meas.q[:-2]) / dt ** 2
-    # u_k is held over [t_k, t_k+1) (zero-order hold): the second difference at t_k sees the mean
-    # of u_k-1 and u_k; without this alignment every sampled loop shows a 0.5 T "delay"
-    u_at = np.concatenate([[meas.u[0]], 0.5 * (meas.u[1:] + meas.u[:-1])])
-    drive = cm * u_at + meas.force_ext()
+    # u_k is held over [t_k, t_k+1) (zero-order hold): the second difference sees it aligned
+    held = cm * np.asarray(meas.u, float)
+    drive = seen_by_second_difference(held) + meas.force_ext()
     if resolution is None:
         from .resimulate import resolution_of
         resolution = resolution_of(meas.q)
@@ -188,7 +189,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     change[1:] = slide[1:] != slide[:-1]
     moving &= edge & ~dilate(change, w // 2)
     return Kinematics(meas.t, q, v, a, force, float(cm), w * dt, moving, vf, a_inst, drive, slide,
-                      float(resolution), float(noise), cm * np.asarray(meas.u, float))
+                      held, float(resolution), float(noise))
 
 
 def reference_kinematics(meas: Measurement, model, *, window: float | None = None) -> Kinematics | None:
