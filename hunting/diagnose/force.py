@@ -408,6 +408,16 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                 ranking=ranking, noise_val=noise_v, fits=fits)
 
 
+def _in_place(lib: Library, fits: dict, current: Explanation, name: str, other: str):
+    """(explanation, validation RMS [N]) of ``current`` with ``other`` in the place of ``name``,
+    each at its best variant; (None, inf) when the set is not compatible or not physical."""
+    names = tuple(n for n in lib.variants if n in (set(current.names) - {name}) | {other})
+    if not compatible(names):
+        return None, np.inf
+    alt = fits.get(names) or lib.best_variants(names)
+    return (alt, lib.validation_rms(alt)) if alt.physical else (None, np.inf)
+
+
 def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: float, min_gain: float, dropped: set):
     """(special, explanation, reason) when a member of ``current`` is a special case of a cause of its
     family (``NESTS`` of the general one: a level change is a Stribeck change without a change of
@@ -420,12 +430,8 @@ def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: floa
         for general, mod in CAUSES.items():
             if name not in getattr(mod, "NESTS", ()) or general in dropped or general not in lib.variants:
                 continue
-            names = tuple(n for n in lib.variants if n in (set(current.names) - {name}) | {general})
-            if not compatible(names):
-                continue
-            alt = fits.get(names) or lib.best_variants(names)
-            rms = lib.validation_rms(alt)
-            if alt.physical and rms < (1 - min_gain) * rms_full:
+            alt, rms = _in_place(lib, fits, current, name, general)
+            if alt is not None and rms < (1 - min_gain) * rms_full:
                 return name, alt, (f"{general}, of which it is a special case, explains the validation data better "
                                    f"by at least {min_gain:.0%} ({rms:.4g} against {rms_full:.4g} N RMS)")
     return None
@@ -443,12 +449,8 @@ def _special_case(lib: Library, fits: dict, current: Explanation, rms_full: floa
         for special in getattr(CAUSES[name], "NESTS", ()):
             if special in dropped or special not in lib.variants:
                 continue
-            names = tuple(n for n in lib.variants if n in (set(current.names) - {name}) | {special})
-            if not compatible(names):
-                continue
-            alt = fits.get(names) or lib.best_variants(names)
-            rms = lib.validation_rms(alt)
-            if alt.physical and rms_full >= (1 - min_gain) * rms:
+            alt, rms = _in_place(lib, fits, current, name, special)
+            if alt is not None and rms_full >= (1 - min_gain) * rms:
                 return name, alt, (f"its special case {special} explains the validation data as well, within "
                                    f"{min_gain:.0%} ({rms:.4g} against {rms_full:.4g} N RMS): the extra freedom is "
                                    "not needed")
