@@ -19,7 +19,11 @@ datasets); ``reporting2`` (a never-seen reporting set: ``reporting``'s counts wi
 ``draw.ALL_CAUSES``, the level effect in proportion); ``reporting3`` (the same plan on a new
 stream: ``reporting2`` judged hunting-35f352b and was then looked at, so the verdict on what
 changed after it, tuned on ``tuning`` only, needs data no one has seen); ``reporting4`` (the
-same plan on stream 7, for the verdict after ``reporting3`` was looked at).
+same plan on stream 7, for the verdict after ``reporting3`` was looked at); ``tuning-clean`` (300
+clean datasets on stream 8: the per-cause false-alarm rates of the tuning side, which 60 clean
+datasets cannot resolve at 1 %); ``reporting5`` (stream 9, for the verdict after ``reporting4``
+was looked at, with 300 clean datasets so that a 1 % false-alarm rate per cause can be told
+from 2-3 %).
 
     python -m benchmarks.blind.generate tuning /work/wt/blind-data/tuning
     python -m benchmarks.blind.generate tuning-level /work/wt/blind-data/tuning-level
@@ -39,16 +43,16 @@ from . import draw, measures, programme
 from .system import Sensor, nominal_json, run
 
 FAMILIES = {"tuning": 1, "reporting": 2, "test": 3, "tuning-level": 4, "reporting2": 5, "reporting3": 6,
-            "reporting4": 7}
+            "reporting4": 7, "tuning-clean": 8, "reporting5": 9}
 # (clean, single effect, two effects)
 SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0), "tuning-level": (0, 24, 0),
          "reporting2": (120, 224, 112), "reporting3": (120, 224, 112),
-         "reporting4": (120, 224, 112)}
+         "reporting4": (120, 224, 112), "tuning-clean": (300, 0, 0), "reporting5": (300, 224, 112)}
 # the causes each family draws its effects from (the families drawn before ``level`` existed keep
 # their list: their datasets are a function of it)
 FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.CAUSES, "tuning-level": ("level",),
                  "reporting2": draw.ALL_CAUSES, "reporting3": draw.ALL_CAUSES,
-                 "reporting4": draw.ALL_CAUSES}
+                 "reporting4": draw.ALL_CAUSES, "tuning-clean": draw.ALL_CAUSES, "reporting5": draw.ALL_CAUSES}
 # the tests' subset: short records, the strong half of the size range, ten causes
 SHORT = ("test",)
 TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
