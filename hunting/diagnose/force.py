@@ -85,10 +85,12 @@ class Explanation:
 
 class Library:
     """Every testable force-channel cause with its variants, and the whitened Gram matrix of
-    all their regressors on the thinned fitting data."""
+    all their regressors on the thinned fitting data. method_error : (fitting, validation)
+    :class:`~hunting.diagnose.method_error.MethodError` or None each, subtracted from the
+    records' residuals."""
 
     def __init__(self, names, kf: Kinematics, kv: Kinematics, model: NominalModel, used_f, used_v, step: int,
-                 kr: Kinematics | None = None, instrument=None):
+                 kr: Kinematics | None = None, instrument=None, method_error=(None, None)):
         self.model = model
         self.kf, self.kv, self.kr = kf, kv, kr
         # instrument(model) -> Kinematics | None: the validation run re-simulated noise-free with a
@@ -96,8 +98,12 @@ class Library:
         self.instrument, self._instruments = instrument, {}
         self.untested: dict = {}
         self.variants: dict = {}
-        self.rf = residual(kf, model)
-        self.rv = residual(kv, model)
+        # the data's residual less the nominal model's own on its noise-free loop (the estimation's
+        # error, :mod:`hunting.diagnose.method_error`), on the fitting and validation records
+        ef, ev = method_error
+        self.rf = residual(kf, model) - (0.0 if ef is None else ef.force)
+        self.rv = residual(kv, model) - (0.0 if ev is None else ev.force)
+        self.method_error = method_error
         self.used_f, self.used_v = used_f, used_v
         self.Sf, self.Sv = Samples.thin(used_f, step), Samples.thin(used_v, step)
         for name in names:

@@ -277,3 +277,11 @@ def residual(kin: Kinematics, model) -> np.ndarray:
     # at rest the acceleration is zero (its second differences are the encoder's counts)
     g = np.where(s, need - model.mass * kin.a_inst - sliding, need - stick_set)
     return kin.filtered(g)
+
+
+def used_samples(kin: Kinematics, model) -> np.ndarray:
+    """bool (n,): the samples the force channel judges: sliding samples with |v| above 2 % of
+    the maximum and above the model's stick speed (creep in presliding is not sliding), where the
+    friction map's own uncertainty cannot dominate the residual (:func:`map_uncertain`: a steep
+    Stribeck dip crossed within a few samples)."""
+    return kin.moving & (np.abs(kin.v) > model.v_stick()) & ~map_uncertain(kin, model)

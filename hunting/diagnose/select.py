@@ -44,7 +44,7 @@ import numpy as np
 from ..errors import SystemDefinitionError
 from .causes import CAUSES
 from .data import Measurement
-from .kinematics import Kinematics, kinematics, map_uncertain, reference_kinematics
+from .kinematics import Kinematics, kinematics, reference_kinematics, used_samples
 from .model import NominalModel
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
@@ -55,6 +55,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much, and the general one to the special case otherwise); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%}")
 CRITERION = RULE
+METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
+               "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
+               "validation data)")
 
 
 @dataclass(frozen=True)
@@ -215,9 +218,13 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         kr = reference_kinematics(validate, model, window=window)
         inst = ((lambda m: reference_kinematics(validate, m, window=window)) if kr is not None and model.controller is not None
                 else None)
-        lib = Library(force_names, kf, kv, model, kf.moving, kv.moving, step, kr, inst)
-        untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
-        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference), min_gain)
+        from .method_error import method_error
+        errors = (method_error(fit, kf, model), method_error(validate, kv, model))
+        if any(e is not None for e in errors):
+            notes.append(METHOD_NOTE.format(*(("not formed" if e is None else f"{e.rms:.3g} N RMS") for e in errors)))
+        fc = _identified_force_channel(lambda names: Library(names, kf, kv, model, kf.moving, kv.moving, step, kr, inst,
+                                                             errors),
+                                       force_names, model, max_causes, alpha, min_gain, alpha_reference, untested)
     else:
         if force_names:
             why = ("fewer than 100 sliding samples (|v| > 2 % of the maximum, half a filter window from stops and "
@@ -312,14 +319,6 @@ def default_window(fit: Measurement, validate: Measurement, model: NominalModel)
     return min(w, dt * (min(fit.n, validate.n) // 4))
 
 
-def used_samples(kin: Kinematics, model: NominalModel) -> np.ndarray:
-    """bool (n,): the samples the force channel judges: sliding samples with |v| above 2 % of
-    the maximum and above the model's stick speed (creep in presliding is not sliding), where the
-    friction map's own uncertainty cannot dominate the residual (:func:`map_uncertain`: a steep
-    Stribeck dip crossed within a few samples)."""
-    return kin.moving & (np.abs(kin.v) > model.v_stick()) & ~map_uncertain(kin, model)
-
-
 class _Progress:
     """Calls progress(stage, done, total) as each of ``total`` stages starts (done: the stages
     finished before it) and once at the end (done = total)."""
@@ -374,6 +373,36 @@ def _members_parameters(lib, ex, cov=None) -> list:
         out.append((name, v.hyper, th.copy(), pars, sig, inc, cur))
         k += kk
     return out
+
+
+def _identified_force_channel(library, names, model, max_causes, alpha, min_gain, alpha_reference, untested) -> dict:
+    """The force channel's result (:func:`_force_channel`) with every selected cause identified:
+    a cause whose ``unidentified(parameters, sigma)`` hook gives a reason (its fitted parameters do
+    not single it out, e.g. a reversal scale within two standard uncertainties of zero) is taken
+    out of the library and the channel judged again without it; each such cause gets a rejected
+    row (step "identification") ahead of the others. library(names) builds the Library; the
+    untested causes of the first one are appended to ``untested``. At most len(names) + 1 passes:
+    each pass but the last removes at least one cause."""
+    from .force import select
+    excluded: list = []
+    identification: list = []
+    for _ in range(len(names) + 1):
+        lib = library([n for n in names if n not in excluded])
+        if not excluded:
+            untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
+        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference), min_gain)
+        fails = [(c, getattr(CAUSES[c.name], "unidentified", lambda *a: None)(c.parameters, c.sigma))
+                 for c in fc["causes"]]
+        fails = [(c, why) for c, why in fails if why]
+        if not fails:
+            break
+        excluded += [c.name for c, _ in fails]
+        identification += [dict(name=c.name, step="identification", statistic=c.statistic, p_value=c.p_value,
+                                validation_gain=c.gain["nominal"] / max(c.gain["extended"], 1e-300) - 1, reason=why)
+                           for c, why in fails]
+    if identification:
+        fc["rejected"] = identification + [r for r in fc["rejected"] if r["name"] not in excluded]
+    return fc
 
 
 def _force_channel(lib, model, sel, min_gain: float) -> dict:

@@ -109,6 +109,8 @@ class NoiseModel:
         m = e.size
         p_max = int(max(0, min(p_max, m // 20)))
         c = autocovariance(e, run, p_max)
+        if not c[0] > 0:            # a residual that is exactly zero (a model fitting its own noise-free data)
+            return NoiseModel(np.zeros(0), 0.0)
         best = (np.log(max(c[0], 1e-300)), np.zeros(0), float(c[0]))
         for p in range(1, p_max + 1):
             phi = linalg.solve_toeplitz(c[:p], c[1:p + 1])

@@ -8,9 +8,10 @@ motion before the record does; the record's first rest is skipped (how long the 
 before it is unknown). At rest a = 0, so the force friction carries is F = cm u + f_ext - offset
 - F_cog(q) (u aligned for the zero-order hold, a straight line through the last 10 ms of the
 rest). The break-away happened some time D before the position left the rest's count: D is the
-time the mass needs to cover that band from rest when only the force's ramp drives it (below
-the Stribeck velocity sliding friction is still about Fs), so F is read D before the last sample
-still at rest (:func:`rests`; unbiased without dwell, low with it). Its excess over the model's
+time the mass needs to cover that band from rest driven by the force's ramp and by the
+break-away force's excess over Fs (below the Stribeck velocity sliding friction is still about
+Fs), solved together with the reading by fixed-point passes, so F is read D before the last
+sample still at rest (:func:`rests`). Its excess over the model's
 break-away force in the direction of the motion that follows is e_k. The extension fits, on the
 fitting data's rests,
 
@@ -39,6 +40,7 @@ MIN_RESTS = 5          # fitting rests: three parameters (level, gain, time) and
 MIN_VALIDATION = 3     # validation rests for the gain
 REST_WINDOW = 0.015    # [s] a rest: the position within two counts for this long
 DRAWS = 20000          # permutations of the growth test (p >= 5e-5)
+DEPARTURE_PASSES = 4   # fixed-point passes of the break-away reading (departure time and excess force)
 
 
 def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -86,15 +88,20 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
         sd.append(np.sign(F_end) if abs(F_end) > 0.5 * Fs else np.sign(meas.q[m] - q_rest))
         # the position leaves the rest's band only some time D after the break-away, and the
         # force has ramped on meanwhile: read it D before the middle of the last still interval,
-        # D the time the mass needs to cover the band from rest when only the ramp drives it
-        # (below the Stribeck velocity sliding friction is still about Fs). Without a dwell
-        # effect that is the departure (the reading is unbiased under the null); a grown
-        # break-away force drives it faster, so the reading errs low (conservative)
+        # D the time the mass needs to cover the band from rest, driven by the ramp and by the
+        # break-away force's excess over Fs (below the Stribeck velocity sliding friction is still
+        # about Fs). D and the reading are solved together by fixed-point passes from no excess:
+        # each pass reads later and higher, so they rise monotonically to the fixed point (with
+        # the ramp alone a grown break-away force was read low)
         toward = max(sd[-1] * slope, 0.0) / dt          # [N/s] the ramp toward the motion
-        D = departure_time(0.75 * resolution, model.mass, 0.0, toward)
+        Fs_dir = (model.curve.positive if sd[-1] > 0 else model.curve.negative).Fs
         x_end = n_fit - 1.0
         x_min = -float(min(k_end - n_fit + 1 - a, 3 * n_fit))     # within the rest: the line extrapolated
-        x_b = min(max(x_end + 0.5 - D / dt, x_min), x_end)
+        drop = 0.0
+        for _ in range(DEPARTURE_PASSES):
+            D = departure_time(0.75 * resolution, model.mass, drop, toward)
+            x_b = min(max(x_end + 0.5 - D / dt, x_min), x_end)
+            drop = max(sd[-1] * float(icpt + slope * x_b) - Fs_dir, 0.0)
         Fb.append(float(icpt + slope * x_b))
         tr.append((k_end - n_fit + 1 + x_b - a + 0.5) * dt)
         rp.append(abs(float(slope)) * (x_end - x_b + 1.0))
