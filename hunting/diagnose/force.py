@@ -43,6 +43,7 @@ from .model import NominalModel
 from .stats import NoiseModel, Samples, gls, out_of_sample
 
 PRECISION = 1e-4      # a cause must remove more than this fraction of the drive force's RMS
+CANCEL = 3.0          # a member's force change beyond this many drive-force RMS is cancelled by the others
 PRECISION_WORDS = 10.0   # reports call a residual "numerical precision" up to this many floors (words only)
 
 
@@ -165,6 +166,7 @@ class Library:
         self.m = Zw.shape[0]
         self.G = Zw.T @ Zw
         self.X_thin, self.S_thin, self.y_thin = X, S, y
+        self.drive_rms = _rms(self.kf.force[idx]) if idx.size else 0.0
 
     def best_alone(self, name, X, S, y) -> tuple:
         """(name, variant index) fitting y best on its own (unwhitened, thinned samples); ties
@@ -200,7 +202,27 @@ class Library:
         rss = max(rss, 1e-300 * max(yy, 1.0))
         hyp = sum(CAUSES[n].HYPERS for n, _ in members)
         bic = self.m * np.log(rss / self.m) + (len(cols) + hyp) * np.log(self.m)
-        return Explanation(tuple(members), theta, float(bic), rss, cols, _unphysical(self, members, theta))
+        why = _unphysical(self, members, theta)
+        if len(members) > 1:
+            why.update(self.cancelling(members, theta, why))
+        return Explanation(tuple(members), theta, float(bic), rss, cols, why)
+
+    def cancelling(self, members, theta, known: dict) -> dict:
+        """{name: why} for the members of a set whose own force change on the thinned fitting data
+        exceeds ``CANCEL`` times the drive force's RMS: changes larger than the force that moves
+        the machine, cancelled by the set's other members, are collinear signatures fitted against
+        each other, not effects (a clean record gave a 8.8e8 kg mass, a 2.6e7 s delay and a level
+        scaled by 2.7e10 that cancelled to a 2 % residual)."""
+        out, k = {}, 0
+        for name, j in members:
+            cols, s = self.slot[(name, j)]
+            part = self.X_thin[:, cols] @ theta[k:k + len(cols)] + (self.S_thin[:, s] if s is not None else 0.0)
+            k += len(cols)
+            size = _rms(part)
+            if name not in known and size > CANCEL * self.drive_rms:
+                out[name] = (f"its force change ({size:.3g} N RMS) is {size / max(self.drive_rms, 1e-300):.3g} times the "
+                             "drive force's: cancelled by the other causes of the set, not an effect of its own")
+        return out
 
     def best_variants(self, names, start=None) -> Explanation:
         """The explanation with the causes ``names``, each at its best variant given the others
