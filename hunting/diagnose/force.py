@@ -14,6 +14,10 @@ The noise model of the prewhitening is fitted on the residual of the whole libra
 testable cause at its best variant at once): a residual that contains no candidate effect, so
 that a strong effect does not pass for noise (the old lag-1 rule collapsed exactly then).
 
+A set in which a member's own force change exceeds ``CANCEL`` times the drive force's RMS is not
+physical (:meth:`Library.cancelling`): collinear signatures fitted against each other cancel to
+a small residual with absurd parameters.
+
 Acceptance (validation data): each member c of the best set must (1) explain the validation
 residual of the set without c out of sample, p < alpha (:func:`stats.out_of_sample`), and (2)
 grow the validation RMS by at least ``min_gain`` (relative) when dropped, and by more than
