@@ -315,6 +315,21 @@ class Library:
                 return mod.design(kx, self.model, v.hyper) @ theta + (shift(kx, self.model, v.hyper) if shift else 0.0)
         raise KeyError(name)
 
+    def in_sample_residual(self, ex: Explanation, which: str) -> np.ndarray:
+        """The residual (thinned samples of the fitting "f" or validation "v" record) of an
+        explanation's members refitted by least squares on that record itself."""
+        S = self.Sf if which == "f" else self.Sv
+        r = (self.rf if which == "f" else self.rv)[S.idx]
+        X, shift = [], np.zeros(S.idx.size)
+        for _, v, _ in self._members(ex):
+            X.append((v.Xf if which == "f" else v.Xv)[S.idx])
+            shift = shift + (v.sf if which == "f" else v.sv)[S.idx]
+        if not X:
+            return r
+        X = np.column_stack(X)
+        theta = np.linalg.lstsq(X, r - shift, rcond=None)[0]
+        return r - shift - X @ theta
+
     def validation_rms(self, ex: Explanation) -> float:
         r = (self.rv - self.prediction(ex, "v"))[self.used_v]
         return float(np.sqrt(np.mean(r ** 2)))
@@ -341,45 +356,18 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
     full = lib.best_variants(tuple(names))
     Sv = lib.Sv
     e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
+    if _rms(e_full) > _rms(lib.rv[Sv.idx]):
+        # the whole library fitted on the fitting data predicts the validation data worse than
+        # nothing (collinear signatures fitted against each other): its residual is no picture of
+        # the noise, and the library is fitted on the validation data itself instead
+        e_full = lib.in_sample_residual(full, "v")
     noise_v = NoiseModel.fit(e_full, Sv.run)
     current = ranking[0]
     floor = PRECISION * _rms(lib.kv.force[lib.used_v])
     dropped: set = set()          # causes that failed on the validation data: no later set holds them
     while True:
-        tests = {}
-        rms_full = lib.validation_rms(current)
-        pred = lib.prediction(current, "v")
-        for name in current.names:
-            rest = tuple(n for n in current.names if n != name)
-            start = {n: j for n, j in current.members if n != name}
-            without = lib.best_variants(rest, start) if rest else lib.fit([])
-            # the test: does this cause's part of the fitted explanation (the others' parts held)
-            # predict the validation residual the others leave?
-            own = lib.part(current, name, "v")
-            e0 = (lib.rv - pred + own)[Sv.idx]
-            gamma, t, p = out_of_sample(e0, own[Sv.idx], Sv.run, noise_v)
-            # the gain: the explanation refitted without it
-            rms_wo = lib.validation_rms(without)
-            tests[name] = dict(gamma=gamma, t=t, p_value=p, gain=rms_wo / max(rms_full, 1e-300) - 1,
-                               rms_without=rms_wo, rms=rms_full, bic_without=without.bic, floor=floor)
-            if lib.kr is not None and getattr(CAUSES[name], "NOISE_FED", False):
-                # the same part along the instrument trajectory: free of the sensor's and the
-                # actuator's noise, which feedback puts into the measured regressors (a delay or
-                # mass "explaining" the loop's reaction to its own noise explains nothing here)
-                yr = lib.part(current, name, "r")[Sv.idx]
-                p_ref = out_of_sample(e0, yr, Sv.run, noise_v)[2]
-                # or along the extended model's loop, at half the level (either suffices: the
-                # check's false-pass rate stays below 1.5 alpha_reference, and a cause the nominal
-                # loop already confirms is not charged for the second look)
-                yx = lib.extended_part(current, name)
-                yx = None if yx is None else yx[Sv.idx]
-                # a loop the extension drives unstable is no instrument
-                if yx is not None and np.all(np.isfinite(yx)) and 0 < _rms(yx) <= 100 * _rms(own[Sv.idx]):
-                    p_ref = min(p_ref, 2.0 * out_of_sample(e0, yx, Sv.run, noise_v)[2])
-                tests[name]["p_reference"] = p_ref
-        failing = [n for n in current.names if tests[n]["p_value"] >= alpha or tests[n]["gain"] < min_gain
-                   or tests[n].get("p_reference", 0.0) >= alpha_reference
-                   or tests[n]["rms_without"] - tests[n]["rms"] <= floor]
+        tests, rms_full = _tests(lib, current, noise_v, floor)
+        failing = [n for n in current.names if _fails(tests[n], alpha, min_gain, alpha_reference)]
         if failing:
             worst = min(failing, key=lambda n: tests[n]["gain"])
             rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
@@ -424,9 +412,11 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                                             "({:.4g} against {:.4g} N RMS)".format(", ".join(sub) or "nominal model",
                                                                                     min_gain, rms_full, rms_sub)))
         current = alt
+    current = _forward(lib, fits, current, dropped, max_causes, noise_v, floor, alpha, min_gain, alpha_reference)
+    tests = _tests(lib, current, noise_v, floor)[0] if current.members else {}
     # one row per cause: the last verdict (a cause unphysical alone may be rejected later on the
     # validation data inside a larger set); causes never in the best set say how they fared alone
-    last = {r["name"]: r for r in rejected}
+    last = {r["name"]: r for r in rejected if r["name"] not in current.names}
     rms0 = lib.validation_rms(fits[()])
     for name in names:
         if name in last or name in current.names:
@@ -439,6 +429,83 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
     return dict(explanation=current, tests=tests if current.members else {}, rejected=list(last.values()),
                 ranking=ranking, noise_val=noise_v, fits=fits)
 
+
+def _fails(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:
+    """Whether a member's tests (:func:`_tests`) fail the rule."""
+    return (t["p_value"] >= alpha or t["gain"] < min_gain or t.get("p_reference", 0.0) >= alpha_reference
+            or t["rms_without"] - t["rms"] <= t["floor"])
+
+
+def _forward(lib: Library, fits: dict, current: Explanation, dropped: set, max_causes: int, noise_v, floor: float,
+             alpha: float, min_gain: float, alpha_reference: float) -> Explanation:
+    """The forward half of the stepwise selection: a cause that failed beside others (dropped
+    from a set whose other members were later dropped too) may hold beside what remains. Each
+    round adds, of the dropped causes whose set with ``current`` is compatible and physical and
+    passes the whole rule (every member's tests, and the set beats each of its subsets by
+    ``min_gain``), the one of best BIC on the fitting data; at most max_causes - len(current)
+    rounds. An offset that explains 61 % of the validation residual alone failed beside level,
+    mass and delay (p = 0.2: level took its place) and was lost when they were dropped."""
+    for _ in range(max(max_causes - len(current.names), 0)):
+        best = None
+        for name in sorted(dropped - set(current.names)):
+            names = tuple(n for n in lib.variants if n in set(current.names) | {name})
+            if not compatible(names):
+                continue
+            alt = fits.get(names) or lib.best_variants(names, {n: j for n, j in current.members})
+            if not alt.physical or (best is not None and alt.bic >= best.bic):
+                continue
+            tests, rms_full = _tests(lib, alt, noise_v, floor)
+            if any(_fails(tests[n], alpha, min_gain, alpha_reference) for n in names):
+                continue
+            subsets = (fits.get(sub) or lib.best_variants(sub) for k in range(len(names) - 1)
+                       for sub in itertools.combinations(names, k))
+            if any(sub.physical and (lib.validation_rms(sub) < (1 + min_gain) * rms_full
+                                     or lib.validation_rms(sub) - rms_full <= floor) for sub in subsets):
+                continue
+            best = alt
+        if best is None:
+            break
+        current = best
+    return current
+
+
+def _tests(lib: Library, current: Explanation, noise_v, floor: float) -> tuple[dict, float]:
+    """Per member of ``current``: its out-of-sample test on the validation data (gamma, t,
+    p_value), its drop-one gain, the validation RMS with and without it and, for noise-fed causes
+    with an instrument, p_reference (module docstring); and the set's validation RMS."""
+    Sv = lib.Sv
+    tests = {}
+    rms_full = lib.validation_rms(current)
+    pred = lib.prediction(current, "v")
+    for name in current.names:
+        rest = tuple(n for n in current.names if n != name)
+        start = {n: j for n, j in current.members if n != name}
+        without = lib.best_variants(rest, start) if rest else lib.fit([])
+        # the test: does this cause's part of the fitted explanation (the others' parts held)
+        # predict the validation residual the others leave?
+        own = lib.part(current, name, "v")
+        e0 = (lib.rv - pred + own)[Sv.idx]
+        gamma, t, p = out_of_sample(e0, own[Sv.idx], Sv.run, noise_v)
+        # the gain: the explanation refitted without it
+        rms_wo = lib.validation_rms(without)
+        tests[name] = dict(gamma=gamma, t=t, p_value=p, gain=rms_wo / max(rms_full, 1e-300) - 1,
+                           rms_without=rms_wo, rms=rms_full, bic_without=without.bic, floor=floor)
+        if lib.kr is not None and getattr(CAUSES[name], "NOISE_FED", False):
+            # the same part along the instrument trajectory: free of the sensor's and the
+            # actuator's noise, which feedback puts into the measured regressors (a delay or
+            # mass "explaining" the loop's reaction to its own noise explains nothing here)
+            yr = lib.part(current, name, "r")[Sv.idx]
+            p_ref = out_of_sample(e0, yr, Sv.run, noise_v)[2]
+            # or along the extended model's loop, at half the level (either suffices: the
+            # check's false-pass rate stays below 1.5 alpha_reference, and a cause the nominal
+            # loop already confirms is not charged for the second look)
+            yx = lib.extended_part(current, name)
+            yx = None if yx is None else yx[Sv.idx]
+            # a loop the extension drives unstable is no instrument
+            if yx is not None and np.all(np.isfinite(yx)) and 0 < _rms(yx) <= 100 * _rms(own[Sv.idx]):
+                p_ref = min(p_ref, 2.0 * out_of_sample(e0, yx, Sv.run, noise_v)[2])
+            tests[name]["p_reference"] = p_ref
+    return tests, rms_full
 
 def _in_place(lib: Library, fits: dict, current: Explanation, name: str, other: str):
     """(explanation, validation RMS [N]) of ``current`` with ``other`` in the place of ``name``,
