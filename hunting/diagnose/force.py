@@ -31,7 +31,11 @@ the validation data). A member that is a special case of a cause of its family (
 of stribeck) gives way to it when the set with the general cause in its place explains the
 validation data better by ``min_gain``; a general cause gives way to its special case (viscous of
 asymmetry, level of stribeck) when it does not. Every change of the set drops at least one cause for good,
-so the loop ends. What remains is the
+so the loop ends. Then the forward half (:func:`_forward`): a dropped cause that, added to what
+remains, passes the whole rule is taken back (the best BIC first, up to ``max_causes``): a cause
+can fail beside members that are later dropped themselves. The out-of-sample tests' noise model
+is fitted on the validation residual of the whole library (coefficients from the fitting data),
+or of the library refitted on the validation data when that prediction is worse than none. What remains is the
 explanation; the sets that came next in BIC and the causes of the same family (shared
 signature) that would replace a selected one are its alternatives."""
 from __future__ import annotations
