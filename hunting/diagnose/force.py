@@ -319,21 +319,6 @@ class Library:
                 return mod.design(kx, self.model, v.hyper) @ theta + (shift(kx, self.model, v.hyper) if shift else 0.0)
         raise KeyError(name)
 
-    def in_sample_residual(self, ex: Explanation, which: str) -> np.ndarray:
-        """The residual (thinned samples of the fitting "f" or validation "v" record) of an
-        explanation's members refitted by least squares on that record itself."""
-        S = self.Sf if which == "f" else self.Sv
-        r = (self.rf if which == "f" else self.rv)[S.idx]
-        X, shift = [], np.zeros(S.idx.size)
-        for _, v, _ in self._members(ex):
-            X.append((v.Xf if which == "f" else v.Xv)[S.idx])
-            shift = shift + (v.sf if which == "f" else v.sv)[S.idx]
-        if not X:
-            return r
-        X = np.column_stack(X)
-        theta = np.linalg.lstsq(X, r - shift, rcond=None)[0]
-        return r - shift - X @ theta
-
     def validation_rms(self, ex: Explanation) -> float:
         r = (self.rv - self.prediction(ex, "v"))[self.used_v]
         return float(np.sqrt(np.mean(r ** 2)))
@@ -360,11 +345,14 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
     full = lib.best_variants(tuple(names))
     Sv = lib.Sv
     e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
-    if _rms(e_full) > _rms(lib.rv[Sv.idx]):
+    for _ in range(len(names)):
+        if _rms(e_full) <= _rms(lib.rv[Sv.idx]) or full.physical:
+            break
         # the whole library fitted on the fitting data predicts the validation data worse than
-        # nothing (collinear signatures fitted against each other): its residual is no picture of
-        # the noise, and the library is fitted on the validation data itself instead
-        e_full = lib.in_sample_residual(full, "v")
+        # nothing, with members that are not physical (collinear signatures fitted against each
+        # other): its residual is no picture of the noise; those members are left out
+        full = lib.best_variants(tuple(n for n in full.names if n not in full.unphysical))
+        e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
     noise_v = NoiseModel.fit(e_full, Sv.run)
     current = ranking[0]
     floor = PRECISION * _rms(lib.kv.force[lib.used_v])
