@@ -144,8 +144,8 @@ def test_validation_noise_model_survives_a_cancelled_library_fit():
     """tuning d0207: a 0.081 N offset (61 % of the validation residual when modelled) and a
     0.6 ms delay too small to matter. The whole library fitted on the fitting data predicted the
     validation data worse than nothing, and a noise model of that residual made the offset's test
-    p = 0.2: nothing was reported. Refitted on the validation data, the noise model is the noise's
-    and the offset is found, within 1 % of the truth."""
+    p = 0.2: nothing was reported. Without the library's unphysical members the noise model is the
+    noise's and the offset is found, within 1 % of the truth."""
     fit, val, model, truth = _dataset("tuning", 207)
     assert truth["causes"] == ["offset", "delay"]
     d = diagnose(fit, model, val, behaviour=False)

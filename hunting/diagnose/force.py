@@ -35,7 +35,7 @@ so the loop ends. Then the forward half (:func:`_forward`): a dropped cause that
 remains, passes the whole rule is taken back (the best BIC first, up to ``max_causes``): a cause
 can fail beside members that are later dropped themselves. The out-of-sample tests' noise model
 is fitted on the validation residual of the whole library (coefficients from the fitting data),
-or of the library refitted on the validation data when that prediction is worse than none. What remains is the
+without its unphysical members when that prediction is worse than none. What remains is the
 explanation; the sets that came next in BIC and the causes of the same family (shared
 signature) that would replace a selected one are its alternatives."""
 from __future__ import annotations
