@@ -31,9 +31,7 @@ the validation data). A member that is a special case of a cause of its family (
 of stribeck) gives way to it when the set with the general cause in its place explains the
 validation data better by ``min_gain``; a general cause gives way to its special case (viscous of
 asymmetry, level of stribeck) when it does not. Every change of the set drops at least one cause for good,
-so the loop ends. Then the forward half (:func:`_forward`): a dropped cause that, added to what
-remains, passes the whole rule is taken back (the best BIC first, up to ``max_causes``): a cause
-can fail beside members that are later dropped themselves. The out-of-sample tests' noise model
+so the loop ends. The out-of-sample tests' noise model
 is fitted on the validation residual of the whole library (coefficients from the fitting data),
 without its unphysical members when that prediction is worse than none. What remains is the
 explanation; the sets that came next in BIC and the causes of the same family (shared
@@ -404,11 +402,9 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                                             "({:.4g} against {:.4g} N RMS)".format(", ".join(sub) or "nominal model",
                                                                                     min_gain, rms_full, rms_sub)))
         current = alt
-    current = _forward(lib, fits, current, dropped, max_causes, noise_v, floor, alpha, min_gain, alpha_reference)
-    tests = _tests(lib, current, noise_v, floor)[0] if current.members else {}
     # one row per cause: the last verdict (a cause unphysical alone may be rejected later on the
     # validation data inside a larger set); causes never in the best set say how they fared alone
-    last = {r["name"]: r for r in rejected if r["name"] not in current.names}
+    last = {r["name"]: r for r in rejected}
     rms0 = lib.validation_rms(fits[()])
     for name in names:
         if name in last or name in current.names:
@@ -427,38 +423,6 @@ def _fails(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bo
     return (t["p_value"] >= alpha or t["gain"] < min_gain or t.get("p_reference", 0.0) >= alpha_reference
             or t["rms_without"] - t["rms"] <= t["floor"])
 
-
-def _forward(lib: Library, fits: dict, current: Explanation, dropped: set, max_causes: int, noise_v, floor: float,
-             alpha: float, min_gain: float, alpha_reference: float) -> Explanation:
-    """The forward half of the stepwise selection: a cause that failed beside others (dropped
-    from a set whose other members were later dropped too) may hold beside what remains. Each
-    round adds, of the dropped causes whose set with ``current`` is compatible and physical and
-    passes the whole rule (every member's tests, and the set beats each of its subsets by
-    ``min_gain``), the one of best BIC on the fitting data; at most max_causes - len(current)
-    rounds. An offset that explains 61 % of the validation residual alone failed beside level,
-    mass and delay (p = 0.2: level took its place) and was lost when they were dropped."""
-    for _ in range(max(max_causes - len(current.names), 0)):
-        best = None
-        for name in sorted(dropped - set(current.names)):
-            names = tuple(n for n in lib.variants if n in set(current.names) | {name})
-            if not compatible(names):
-                continue
-            alt = fits.get(names) or lib.best_variants(names, {n: j for n, j in current.members})
-            if not alt.physical or (best is not None and alt.bic >= best.bic):
-                continue
-            tests, rms_full = _tests(lib, alt, noise_v, floor)
-            if any(_fails(tests[n], alpha, min_gain, alpha_reference) for n in names):
-                continue
-            subsets = (fits.get(sub) or lib.best_variants(sub) for k in range(len(names) - 1)
-                       for sub in itertools.combinations(names, k))
-            if any(sub.physical and (lib.validation_rms(sub) < (1 + min_gain) * rms_full
-                                     or lib.validation_rms(sub) - rms_full <= floor) for sub in subsets):
-                continue
-            best = alt
-        if best is None:
-            break
-        current = best
-    return current
 
 
 def _tests(lib: Library, current: Explanation, noise_v, floor: float) -> tuple[dict, float]:
