@@ -128,3 +128,40 @@ def test_dwell_growth_test_finds_a_growth():
     e = e + 1.0 * (1 - np.exp(-t / 0.1))
     rho, p = dwell.growth_test(t, e, s, scale, draws=2000, seed=1)
     assert rho > 0.5 and p == pytest.approx(1 / 2001)
+
+
+def _rest_then_break_away(delta: float, ramp: float = 20.0, dt: float = 1e-3, res: float = 1e-6, m: float = 1.0,
+                          Fs: float = 1.0):
+    """A record in closed form: the mass moves, rests 0.15 s under a drive force ramping at
+    ``ramp`` [N/s], breaks away when the force reaches Fb = Fs + delta and then moves under the
+    net force delta + ramp tau (sliding friction Fs): q = delta tau^2 / 2m + ramp tau^3 / 6m,
+    quantized to ``res``. Returns (measurement, model, Fb)."""
+    model = NominalModel.from_dict({"plant": {"mass": m, "motor_constant": 1.0},
+                                    "friction": {"law": "coulomb-viscous", "Fc": Fs, "b": 0.0},
+                                    "sensor": {"resolution": res}})
+    t = np.arange(0.0, 0.4, dt)
+    t0, tb = 0.05, 0.2
+    Fb = Fs + delta
+    F = np.where(t < tb, Fb - ramp * (tb - t), Fb + ramp * (t - tb))
+    tau = np.clip(t - tb, 0.0, None)
+    q = np.where(t < t0, -(t0 - t) * 2e-3, 0.0) + delta * tau ** 2 / (2 * m) + ramp * tau ** 3 / (6 * m)
+    return Measurement(t, res * np.round(q / res), F), model, Fb
+
+
+@pytest.mark.parametrize("delta", [0.0, 0.2, 0.5, 1.0])
+def test_dwell_reads_the_break_away_force_of_a_closed_form_rest(delta, monkeypatch):
+    """The break-away reading against the closed form: within 0.03 N of Fb (1.5 ms of the 20 N/s
+    ramp: the sampling's share) whether or not the break-away force exceeds Fs, and the rest's
+    duration 0.15 s within 2 ms. With the departure driven by the ramp alone (one pass, no
+    excess) a break-away force above Fs was read 0.08-0.12 N low."""
+    meas, model, Fb = _rest_then_break_away(delta)
+    t_rest, F, s, _ = dwell.rests(meas, model, 1e-6)
+    assert F.size == 1 and s[0] == 1.0
+    assert abs(F[0] - Fb) < 0.03
+    assert abs(t_rest[0] - 0.15) < 2e-3
+    monkeypatch.setattr(dwell, "DEPARTURE_PASSES", 1)
+    F_ramp_only = dwell.rests(meas, model, 1e-6)[1][0]
+    if delta > 0:
+        assert Fb - F_ramp_only > 0.06
+    else:
+        assert F_ramp_only == pytest.approx(F[0])

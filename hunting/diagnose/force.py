@@ -110,7 +110,6 @@ class Library:
         ef, ev = method_error
         self.rf = residual(kf, model) - (0.0 if ef is None else ef.force)
         self.rv = residual(kv, model) - (0.0 if ev is None else ev.force)
-        self.method_error = method_error
         self.used_f, self.used_v = used_f, used_v
         self.Sf, self.Sv = Samples.thin(used_f, step), Samples.thin(used_v, step)
         for name in names:

@@ -125,9 +125,9 @@ def run(out: Path) -> int:
         print(f"    max |lambda1 - 1| / max(1, |lambda2|) = {np.max(triv):.1e}")
         # 1e-4: next to a grazing point (an event almost tangent) the saltation matrix divides by
         # a small n . f, which amplifies the event-time error (4.7e-5 at K = 0.58, LuGre), and the
-        # corrector's multipliers come from a Jacobian it updates by Broyden steps (2.0e-4 at
-        # K = 0.573 with numba 0.68 / numpy 2.4): points above it are checked again by shooting
-        # on the orbit itself with a fresh monodromy matrix
+        # branch's multipliers are only as accurate as its corrector (2.0e-4 at K = 0.573 with
+        # numba 0.68 / numpy 2.4; a tighter newton_tol shrinks such errors tenfold): points above
+        # it are checked again by shooting on the orbit itself
         again = np.flatnonzero(triv >= 1e-4)
         for i in again:
             c = find_cycle(name, x0=br.x0[i], period_guess=float(br.period[i]), params={"K": float(br.mu[i])})
