@@ -103,3 +103,37 @@ def test_out_of_sample_with_no_residual_left_is_no_test():
     run = np.repeat([0, 1, 2], 35)
     gamma, t, p = out_of_sample(y.copy(), y, run, NoiseModel(np.zeros(0), 1.0))
     assert gamma == pytest.approx(1.0) and p == 1.0
+
+
+def _feedback_draw(rng, theta=2.0):
+    """A regressor measured with the noise that also drives the residual (feedback puts the
+    sensor's noise into the drive and into the force balance alike): x_meas = x + n, y = theta x
+    - 0.8 n + e, with coloured n and e; the instrument is x itself, plus its own small error."""
+    m = SF.idx.size
+    x = KF.filtered(np.sin(np.linspace(0, 40 * np.pi, KF.t.size)) * (1 + KF.v / np.abs(KF.v).max()))[SF.idx]
+    x = x / x.std()
+    n = lfilter([1.0], [1.0, -0.7], rng.normal(size=m)) * 0.5
+    e = lfilter([1.0], [1.0, -0.9], rng.normal(size=m)) * 0.3
+    y = theta * x - 0.8 * n + e
+    z = x + 0.1 * lfilter([1.0], [1.0, -0.5], rng.normal(size=m))
+    return (x + n)[:, None], z[:, None], y
+
+
+def test_instrumented_estimate_removes_the_feedback_bias_and_covers_its_truth():
+    """Errors in variables: least squares (prewhitened or not) of a residual on a regressor that
+    carries the residual's own noise is biased; the instrumented estimate is not, and its
+    standard error covers the truth near its nominal rate: 1.96 sigma held 90.5 % of 200 draws
+    (nominal 95 %; without the autocorrelation terms 63 %)."""
+    from hunting.diagnose.stats import gls, instrumented
+    rng = np.random.default_rng(11)
+    iv, ls, cover = [], [], []
+    for _ in range(200):
+        X, Z, y = _feedback_draw(rng)
+        noise = NoiseModel.fit(y - X[:, 0] * np.linalg.lstsq(X, y, rcond=None)[0], SF.run)
+        th, cov, _, _ = instrumented(X, Z, y, SF.run, noise)
+        iv.append(th[0])
+        ls.append(gls(X, y, SF.run, noise)[0][0])
+        cover.append(abs(th[0] - 2.0) <= 1.96 * np.sqrt(cov[0, 0]))
+    assert abs(np.median(iv) - 2.0) < 0.05, np.median(iv)
+    assert abs(np.median(ls) - 2.0) > 0.1, np.median(ls)        # the bias the instrument removes
+    assert 0.85 <= np.mean(cover) <= 0.99, np.mean(cover)

@@ -175,7 +175,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     :func:`default_window`); behaviour : re-simulate the validation run (needs a controller and
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
-    from .force import Library, select
+    from .force import Library
     from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_saturation, check_units, same_record
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
@@ -216,6 +216,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100:
         step = max(1, int(round(kf.window / fit.dt)) // 3)
         kr = reference_kinematics(validate, model, window=window)
+        kfr = reference_kinematics(fit, model, window=window) if kr is not None else None
         inst = ((lambda m: reference_kinematics(validate, m, window=window)) if kr is not None and model.controller is not None
                 else None)
         from .method_error import method_error
@@ -223,7 +224,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         if any(e is not None for e in errors):
             notes.append(METHOD_NOTE.format(*(("not formed" if e is None else f"{e.rms:.3g} N RMS") for e in errors)))
         fc = _identified_force_channel(lambda names: Library(names, kf, kv, model, kf.moving, kv.moving, step, kr, inst,
-                                                             errors),
+                                                             errors, kfr),
                                        force_names, model, max_causes, alpha, min_gain, alpha_reference, untested)
     else:
         if force_names:
@@ -407,7 +408,8 @@ def _identified_force_channel(library, names, model, max_causes, alpha, min_gain
 
 def _force_channel(lib, model, sel, min_gain: float) -> dict:
     """Causes, extended model, residuals and alternatives from the force channel's selection."""
-    from .force import compatible, refine
+    from .force import compatible
+    from .refine import refine
     ex = sel["explanation"]
     mf, mv = lib.used_f, lib.used_v
     cov, hyper_sigma = None, {}
@@ -521,7 +523,7 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
         return None, (row if reason is None else dict(row, reason=reason)), model
     if p >= alpha:
         return reject(reason="no motion beyond quantization and sensor noise where the model sticks")
-    theta = mod.fit_behaviour(fit, model)[0] if can_sim else mod.fit_quasistatic(kf, model, segs)
+    theta = mod.fit_behaviour(fit, model, segs)[0] if can_sim else mod.fit_quasistatic(kf, model, segs)
     why = mod.at_bound(theta, fit, model) if hasattr(mod, "at_bound") else None
     if why:
         return reject(reason=why)

@@ -4,7 +4,6 @@ cm u(t) - cm u(t - tau). The regressor at a trial delay tau is that difference d
 tau itself when the trial is right, and the Gauss-Newton refinement of tau (``HYPER_KEYS``)
 makes the two agree for delays of many samples, where the first-order term tau cm u' is not
 enough."""
-import numpy as np
 
 from ._words import _q
 
@@ -14,6 +13,7 @@ FAMILY = "velocity"
 HYPERS = 0
 HYPER_KEYS = ("tau",)
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+INSTRUMENTED = True   # its coefficient is estimated with the noise-free loop's regressor as instrument
 UNITS = {"delay": "s"}
 
 

@@ -28,7 +28,6 @@ validation excess minus the fitting mean on the predicted growth without an inte
 that differed between the records passed for growth or hid it). Gain, out of sample: the RMS of
 e on the validation data's rests, nominal (the model's break-away force) against extended."""
 import numpy as np
-from scipy import stats
 from ._words import _count, _q
 
 NAME = "dwell"

@@ -25,6 +25,7 @@ FAMILY = "velocity"
 HYPERS = 1
 HYPER_KEYS = ("tau",)
 NOISE_FED = True      # its regressor is a map of the measured velocity, which feedback fills with noise
+INSTRUMENTED = True   # its coefficient is estimated with the noise-free loop's regressor as instrument
 LAGS = (1e-3, 0.3)    # [s] the trial lags' range (at least two samples)
 N_LAGS = 12
 EXCLUDES = ("reversal",)     # LuGre bristles have their own memory

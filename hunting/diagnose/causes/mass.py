@@ -6,6 +6,7 @@ DESCRIPTION = "mass (inertia)"
 FAMILY = "inertia"
 HYPERS = 0
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+INSTRUMENTED = True   # its coefficient is estimated with the noise-free loop's regressor as instrument
 UNITS = {"mass": "kg"}
 
 

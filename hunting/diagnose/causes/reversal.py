@@ -20,7 +20,10 @@ detection keeps its calibration); the refinement of the selected cause starts fr
 0.2, 0.5 and 1 and moves zeta together with sigma0 by Gauss-Newton (``HYPER_KEYS``, zeta within
 ZETA_RANGE). With the damping ratio held at 0.5, sigma0 absorbed the damping's transient: on the
 blind tuning set (damping ratios 0.3 to 1) the refined sigma0 was up to 22 % off; freed, within
-2.5 % where the reversal is found by the force channel alone.
+2.5 % where the reversal is found by the force channel alone. The reported sigma0 and zeta are
+refined once more with the scale held at 1 (``EXTENSION_COEFFICIENTS``, :func:`~hunting.diagnose.refine.refine`):
+they are the extension's, which builds up the whole level, and the scale, re-estimated at them,
+says how far the data's build-up is from LuGre's.
 
 The extension is the LuGre law with that sigma0 and sigma1 on the nominal curves."""
 import numba
@@ -38,6 +41,7 @@ UNITS = {"sigma0": "N/m", "sigma1": "N s/m", "zeta": "", "scale": ""}
 SCALE_RANGE = (0.3, 3.0)
 ZETA_STARTS = (0.2, 1.0)      # the refinement's other starting damping ratios (the search holds ZETA)
 ZETA_RANGE = (0.05, 5.0)      # damping ratios of the presliding resonance the refinement may reach
+EXTENSION_COEFFICIENTS = (1.0,)   # the extension builds up the whole level: sigma0, zeta are refined at scale 1
 
 
 @numba.njit(cache=True)

@@ -9,6 +9,7 @@ DESCRIPTION = "viscous coefficient b"
 FAMILY = "velocity"
 HYPERS = 0
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
+INSTRUMENTED = True   # its coefficient is estimated with the noise-free loop's regressor as instrument
 UNITS = {"b": "N s/m"}
 RATIO_WORDS = 10.0     # larger changes are given as the two values, not as a ratio
 
