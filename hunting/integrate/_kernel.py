@@ -97,7 +97,8 @@ def _dense_state(method, t_old, h, y_old, Q, t, out, full):
     dense_eval(method, t_old, h, y_old, Q, t, out, full)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+             forceinline=True)
 def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, xb, gs, full):
     dense_eval(method, t_old, h, y_old, Q, t, xs, full)
     _guards_base(guards, mode, t, xs, p, gs, xb)
