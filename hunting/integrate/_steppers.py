@@ -62,7 +62,8 @@ def select_initial_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, 
     return min(100 * h0, h1, direction_span)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+             forceinline=True)
 def dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
              f_new, err, full):
     """One Dormand-Prince 5(4) step (FSAL). Returns the scaled error norm.
@@ -100,7 +101,8 @@ def dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p,
     return _rms_scaled(err, y, y_new, rtol, atol)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+             forceinline=True)
 def dop853_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, f, h, p, rtol, atol, K, ytmp, y_new,
                 f_new, err, full):
     """One DOP853 step (FSAL). Returns Hairer's error norm (3rd/5th order mix).
