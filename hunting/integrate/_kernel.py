@@ -408,18 +408,6 @@ def _make_kernel(full_flag):
         o += 16 * n
         Q = wf[o:o + 7 * n].reshape((7, n))
         o += 7 * n
-        J = wf[o:o + n * n].reshape((n, n))
-        o += n * n
-        M = wf[o:o + 9 * n * n].reshape((3 * n, 3 * n))
-        o += 9 * n * n
-        Mr = wf[o:o + n * n].reshape((n, n))
-        o += n * n
-        Z = wf[o:o + 3 * n].reshape((3, n))
-        o += 3 * n
-        F3 = wf[o:o + 3 * n].reshape((3, n))
-        o += 3 * n
-        R = wf[o:o + 3 * n]
-        o += 3 * n
         g_old = wf[o:o + ng]
         o += ng
         g_new = wf[o:o + ng]
@@ -433,32 +421,52 @@ def _make_kernel(full_flag):
         # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
         h_mode = wf[o:o + n_modes]
         o += n_modes
-        yw = wf[o:o + nb]
-        o += nb
-        fw = wf[o:o + nb]
-        o += nb
-        fp = wf[o:o + nb]
-        o += nb
-        fm = wf[o:o + nb]
-        o += nb
-        fbm = wf[o:o + nb]
-        o += nb
-        fbp = wf[o:o + nb]
-        o += nb
-        gradh = wf[o:o + nb]
-        o += nb
-        xw = wf[o:o + nb]
-        o += nb
-        xw2 = wf[o:o + nb]
-        o += nb
-        Jw = wf[o:o + nb * nb].reshape((nb, nb))
-        o += nb * nb
-        Ssal = wf[o:o + nb * nb].reshape((nb, nb))
-        o += nb * nb
-        Rx = wf[o:o + nb * nb].reshape((nb, nb))
-        piv = wi[0:3 * n]
-        pivr = wi[3 * n:4 * n]
         armed = wi[4 * n:4 * n + ng]
+        if full is not None:
+            # Radau IIA, the variational equations and saltation matrices
+            J = wf[o:o + n * n].reshape((n, n))
+            o += n * n
+            M = wf[o:o + 9 * n * n].reshape((3 * n, 3 * n))
+            o += 9 * n * n
+            Mr = wf[o:o + n * n].reshape((n, n))
+            o += n * n
+            Z = wf[o:o + 3 * n].reshape((3, n))
+            o += 3 * n
+            F3 = wf[o:o + 3 * n].reshape((3, n))
+            o += 3 * n
+            R = wf[o:o + 3 * n]
+            o += 3 * n
+            yw = wf[o:o + nb]
+            o += nb
+            fw = wf[o:o + nb]
+            o += nb
+            fp = wf[o:o + nb]
+            o += nb
+            fm = wf[o:o + nb]
+            o += nb
+            fbm = wf[o:o + nb]
+            o += nb
+            fbp = wf[o:o + nb]
+            o += nb
+            gradh = wf[o:o + nb]
+            o += nb
+            xw = wf[o:o + nb]
+            o += nb
+            xw2 = wf[o:o + nb]
+            o += nb
+            Jw = wf[o:o + nb * nb].reshape((nb, nb))
+            o += nb * nb
+            Ssal = wf[o:o + nb * nb].reshape((nb, nb))
+            o += nb * nb
+            Rx = wf[o:o + nb * nb].reshape((nb, nb))
+            piv = wi[0:3 * n]
+            pivr = wi[3 * n:4 * n]
+        else:
+            # the lean kernel passes the right-hand side's work arrays to the steppers, which do
+            # not touch them without sensitivities: stand-ins of the same types, not 25 more
+            # slices to compile
+            yw = fw = fp = fm = ftmp
+            Jw = K
         for i in range(nz):
             zeno_times[i] = -np.inf
         for i in range(n_modes):
