@@ -57,18 +57,27 @@ JAC_TYPE = types.FunctionType(JAC_SIG)
 MODE_KINDS = ("smooth", "stick", "filippov")
 
 
-def compile_for(disp, sig):
+def compile_for(disp, sig, loop_vectorize: bool = True):
     """Compile numba dispatcher ``disp`` for signature ``sig`` unless it has an overload (numba
     loads it from its disk cache when there) and disable compilation for other types: arguments
     that do not match are an error instead of a silent new specialization. What
     ``numba.njit(sig)`` does at import, done on first use (so importing a module compiles
-    nothing a command does not run). Returns ``disp``."""
+    nothing a command does not run). Returns ``disp``.
+
+    ``loop_vectorize=False`` compiles it (and the functions it compiles in turn) without LLVM's
+    loop vectorizer, for code whose loops run over a few states only (numba reads the setting
+    when it builds each pass pipeline; it is restored afterwards)."""
     if not disp.overloads:
-        with warnings.catch_warnings():
-            # compiling inside a caller's warning context (pytest's resets the filter that
-            # hunting._fastcall installs at import)
-            warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
-            disp.compile(sig)
+        saved = numba.config.LOOP_VECTORIZE
+        try:
+            numba.config.LOOP_VECTORIZE = saved and loop_vectorize
+            with warnings.catch_warnings():
+                # compiling inside a caller's warning context (pytest's resets the filter that
+                # hunting._fastcall installs at import)
+                warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
+                disp.compile(sig)
+        finally:
+            numba.config.LOOP_VECTORIZE = saved
         disp.disable_compile()
     return disp
 
