@@ -115,9 +115,32 @@ class Mode:
             raise SystemDefinitionError(f"mode kind = {self.kind!r} is not allowed: use one of {MODE_KINDS}")
 
 
+# library functions that stand in a PiecewiseSystem before they are compiled (see compile_later)
+_DEFERRED: dict[int, tuple] = {}
+
+
+def compile_later(disp, sig):
+    """Let dispatcher ``disp`` stand in a PiecewiseSystem uncompiled; a kernel's caller compiles
+    it for ``sig`` when that kernel calls it (``kernel_jacobian``). Returns ``disp``."""
+    _DEFERRED[id(disp)] = (disp, sig)
+    return disp
+
+
+def kernel_jacobian(system, used: bool = True) -> tuple:
+    """The ``(jac, has_jac)`` arguments of a kernel call for ``system``. ``used=False`` (the lean
+    kernel, which never calls the Jacobian) passes the placeholder, so a preset's Jacobian (~1.5 s
+    of compile with the functions it calls) compiles only when a kernel that calls it runs."""
+    if system.jacobian is None or not used:
+        return no_jacobian, False
+    return compile_for(system.jacobian, JAC_SIG), True
+
+
 def _check_dispatcher(role: str, fn, sig) -> None:
     if fn is None:
         raise SystemDefinitionError(f"{role} is missing")
+    deferred = _DEFERRED.get(id(fn))
+    if deferred is not None and deferred[0] is fn and deferred[1] == sig:
+        return
     sigs = getattr(fn, "signatures", None)
     if sigs is None:
         raise SystemDefinitionError(
