@@ -25,10 +25,13 @@ from __future__ import annotations
 
 import copy
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
 
+import llvmlite.binding as llvm
 import numba
+import numba.core.codegen as _numba_codegen
 import numpy as np
 from numba import types
 from numba.core.errors import NumbaExperimentalFeatureWarning
@@ -57,27 +60,52 @@ JAC_TYPE = types.FunctionType(JAC_SIG)
 MODE_KINDS = ("smooth", "stick", "filippov")
 
 
-def compile_for(disp, sig, loop_vectorize: bool = True):
+def _pass_builder_without_unrolling(tm, opt=2, loop_vectorize=False, slp_vectorize=False):
+    """numba.core.llvm_bindings.create_pass_builder with LLVM's loop unroller off."""
+    pto = llvm.create_pipeline_tuning_options()
+    pto.speed_level = opt
+    pto.slp_vectorization = slp_vectorize
+    pto.loop_vectorization = loop_vectorize
+    pto.loop_unrolling = False
+    return llvm.create_pass_builder(tm, pto)
+
+
+@contextmanager
+def _small_loops(small: bool):
+    """While compiling: LLVM pass pipelines without the loop vectorizer and the loop unroller
+    when ``small``. numba reads LOOP_VECTORIZE each time it builds a pipeline; unrolling has no
+    numba setting, so its pipeline factory is swapped (only when it has the expected name).
+    Both are restored afterwards."""
+    saved_vec = numba.config.LOOP_VECTORIZE
+    saved_pb = getattr(_numba_codegen, "create_pass_builder", None)
+    try:
+        if small:
+            numba.config.LOOP_VECTORIZE = False
+            if saved_pb is not None:
+                _numba_codegen.create_pass_builder = _pass_builder_without_unrolling
+        yield
+    finally:
+        numba.config.LOOP_VECTORIZE = saved_vec
+        if saved_pb is not None:
+            _numba_codegen.create_pass_builder = saved_pb
+
+
+def compile_for(disp, sig, small_loops: bool = False):
     """Compile numba dispatcher ``disp`` for signature ``sig`` unless it has an overload (numba
     loads it from its disk cache when there) and disable compilation for other types: arguments
     that do not match are an error instead of a silent new specialization. What
     ``numba.njit(sig)`` does at import, done on first use (so importing a module compiles
     nothing a command does not run). Returns ``disp``.
 
-    ``loop_vectorize=False`` compiles it (and the functions it compiles in turn) without LLVM's
-    loop vectorizer, for code whose loops run over a few states only (numba reads the setting
-    when it builds each pass pipeline; it is restored afterwards)."""
+    ``small_loops=True`` compiles it (and the functions it compiles in turn) without LLVM's
+    loop vectorizer and unroller, for code whose loops run over a few states only: their
+    vector and unrolled copies of every loop cost compile time and no run time there."""
     if not disp.overloads:
-        saved = numba.config.LOOP_VECTORIZE
-        try:
-            numba.config.LOOP_VECTORIZE = saved and loop_vectorize
-            with warnings.catch_warnings():
-                # compiling inside a caller's warning context (pytest's resets the filter that
-                # hunting._fastcall installs at import)
-                warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
-                disp.compile(sig)
-        finally:
-            numba.config.LOOP_VECTORIZE = saved
+        with _small_loops(small_loops), warnings.catch_warnings():
+            # compiling inside a caller's warning context (pytest's resets the filter that
+            # hunting._fastcall installs at import)
+            warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
+            disp.compile(sig)
         disp.disable_compile()
     return disp
 

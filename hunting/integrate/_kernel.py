@@ -845,11 +845,11 @@ _DISPATCHERS = {"lean": numba.njit(**_OPTIONS)(_make_kernel(None)), "full": numb
 def compiled(kind: str):
     """The kernel ``kind`` ("lean" or "full"), compiled for KERNEL_SIG on first use.
 
-    The lean kernel compiles without LLVM's loop vectorizer: its loops run over the states of
-    one system (3-4 for the presets), too few for vector code, and the vectorizer's versions of
-    every loop took ~1.3 s of its ~12 s compile at the same run time. The full kernel keeps it
-    (with sensitivities its loops run over n (n + 1) entries)."""
-    return compile_for(_DISPATCHERS[kind], KERNEL_SIG, loop_vectorize=kind != "lean")
+    The lean kernel compiles without LLVM's loop vectorizer and unroller: its loops run over
+    the states of one system (3-4 for the presets), too few for vector code or unrolled copies,
+    which took ~1.3 s and ~1-2 s of its ~12 s compile at the same run time. The full kernel
+    keeps them (with sensitivities its loops run over n (n + 1) entries)."""
+    return compile_for(_DISPATCHERS[kind], KERNEL_SIG, small_loops=kind == "lean")
 
 
 def kernel_for(method: int):
