@@ -56,9 +56,9 @@ def _put_row(dst, row, src):
     """dst[row, :] = src without the temporaries of slice assignment (the kernel runs without NRT).
 
     This and the kernel's other small helpers (``_put``, ``_guards_base``, ``_rhs_at``,
-    ``_dense_state``) are compiled once and called with LLVM's ``alwaysinline``
-    (``forceinline=True``) instead of numba's IR inlining, which copies, re-types and re-lowers a
-    helper at every call site (~20 sites). LLVM then inlines the calls, so the run time is the
+    ``_dense_state``, ``_guard_at``; also ``rhs`` and the steppers) are compiled once and called
+    with LLVM's ``alwaysinline`` (``forceinline=True``) instead of numba's IR inlining, which
+    copies, re-types and re-lowers a helper at every call site (~25 sites). LLVM then inlines the calls, so the run time is the
     same; without ``forceinline`` the calls stayed and simulations and event maps were 3-4 %
     slower."""
     for i in range(src.size):
