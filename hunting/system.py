@@ -25,10 +25,13 @@ from __future__ import annotations
 
 import copy
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import Mapping, Sequence
 
+import llvmlite.binding as llvm
 import numba
+import numba.core.codegen as _numba_codegen
 import numpy as np
 from numba import types
 from numba.core.errors import NumbaExperimentalFeatureWarning
@@ -57,14 +60,48 @@ JAC_TYPE = types.FunctionType(JAC_SIG)
 MODE_KINDS = ("smooth", "stick", "filippov")
 
 
-def compile_for(disp, sig):
+def _pass_builder_without_unrolling(tm, opt=2, loop_vectorize=False, slp_vectorize=False):
+    """numba.core.llvm_bindings.create_pass_builder with LLVM's loop unroller off."""
+    pto = llvm.create_pipeline_tuning_options()
+    pto.speed_level = opt
+    pto.slp_vectorization = slp_vectorize
+    pto.loop_vectorization = loop_vectorize
+    pto.loop_unrolling = False
+    return llvm.create_pass_builder(tm, pto)
+
+
+@contextmanager
+def _small_loops(small: bool):
+    """While compiling: LLVM pass pipelines without the loop vectorizer and the loop unroller
+    when ``small``. numba reads LOOP_VECTORIZE each time it builds a pipeline; unrolling has no
+    numba setting, so its pipeline factory is swapped (only when it has the expected name).
+    Both are restored afterwards."""
+    saved_vec = numba.config.LOOP_VECTORIZE
+    saved_pb = getattr(_numba_codegen, "create_pass_builder", None)
+    try:
+        if small:
+            numba.config.LOOP_VECTORIZE = False
+            if saved_pb is not None:
+                _numba_codegen.create_pass_builder = _pass_builder_without_unrolling
+        yield
+    finally:
+        numba.config.LOOP_VECTORIZE = saved_vec
+        if saved_pb is not None:
+            _numba_codegen.create_pass_builder = saved_pb
+
+
+def compile_for(disp, sig, small_loops: bool = False):
     """Compile numba dispatcher ``disp`` for signature ``sig`` unless it has an overload (numba
     loads it from its disk cache when there) and disable compilation for other types: arguments
     that do not match are an error instead of a silent new specialization. What
     ``numba.njit(sig)`` does at import, done on first use (so importing a module compiles
-    nothing a command does not run). Returns ``disp``."""
+    nothing a command does not run). Returns ``disp``.
+
+    ``small_loops=True`` compiles it (and the functions it compiles in turn) without LLVM's
+    loop vectorizer and unroller, for code whose loops run over a few states only: their
+    vector and unrolled copies of every loop cost compile time and no run time there."""
     if not disp.overloads:
-        with warnings.catch_warnings():
+        with _small_loops(small_loops), warnings.catch_warnings():
             # compiling inside a caller's warning context (pytest's resets the filter that
             # hunting._fastcall installs at import)
             warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
@@ -106,9 +143,32 @@ class Mode:
             raise SystemDefinitionError(f"mode kind = {self.kind!r} is not allowed: use one of {MODE_KINDS}")
 
 
+# library functions that stand in a PiecewiseSystem before they are compiled (see compile_later)
+_DEFERRED: dict[int, tuple] = {}
+
+
+def compile_later(disp, sig):
+    """Let dispatcher ``disp`` stand in a PiecewiseSystem uncompiled; a kernel's caller compiles
+    it for ``sig`` when that kernel calls it (``kernel_jacobian``). Returns ``disp``."""
+    _DEFERRED[id(disp)] = (disp, sig)
+    return disp
+
+
+def kernel_jacobian(system, used: bool = True) -> tuple:
+    """The ``(jac, has_jac)`` arguments of a kernel call for ``system``. ``used=False`` (the lean
+    kernel, which never calls the Jacobian) passes the placeholder, so a preset's Jacobian (~1.5 s
+    of compile with the functions it calls) compiles only when a kernel that calls it runs."""
+    if system.jacobian is None or not used:
+        return no_jacobian, False
+    return compile_for(system.jacobian, JAC_SIG), True
+
+
 def _check_dispatcher(role: str, fn, sig) -> None:
     if fn is None:
         raise SystemDefinitionError(f"{role} is missing")
+    deferred = _DEFERRED.get(id(fn))
+    if deferred is not None and deferred[0] is fn and deferred[1] == sig:
+        return
     sigs = getattr(fn, "signatures", None)
     if sigs is None:
         raise SystemDefinitionError(

@@ -95,3 +95,22 @@ def test_memoized_function_addresses_match_numba():
         for fn, sig in ((sys_.vector_field, VF_SIG), (sys_.guards, GUARD_SIG)):
             assert ft._get_wrapper_address(fn, sig) == _fastcall._orig_wrapper(fn, sig)
             assert ft._get_jit_address(fn, sig) == _fastcall._orig_jit(fn, sig)
+
+
+def test_compile_for_small_loops_restores_numba_settings():
+    """The lean kernel's compile without LLVM's loop vectorizer and unroller leaves numba's
+    settings as they were for everything compiled afterwards."""
+    import numba.core.codegen as codegen
+    from hunting.system import VF_SIG, compile_for
+
+    @numba.njit
+    def vf(mode, t, x, p, out):
+        for i in range(x.size):
+            out[i] = -x[i]
+
+    before = (numba.config.LOOP_VECTORIZE, codegen.create_pass_builder)
+    compile_for(vf, VF_SIG, small_loops=True)
+    assert (numba.config.LOOP_VECTORIZE, codegen.create_pass_builder) == before
+    out = np.empty(3)
+    vf(0, 0.0, np.arange(3.0), np.empty(0), out)
+    np.testing.assert_array_equal(out, -np.arange(3.0))

@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import Status, SystemDefinitionError
 from ..integrate import _kernel as K
 from ..integrate._tableau import METHODS
-from ..system import PiecewiseSystem, no_jacobian
+from ..system import PiecewiseSystem, kernel_jacobian
 
 
 @dataclass(frozen=True)
@@ -74,10 +74,10 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
     cap = max_events + 1
     ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo = K.event_buffers(cap, n)
     yf = np.empty(N)
-    jac = system.jacobian if system.jacobian is not None else no_jacobian
+    jac, has_jac = kernel_jacobian(system)
     nf, ni = K.workspace_sizes(N, n, system.n_guards, system.n_modes, 50)
     K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
-                       system.jacobian is not None, METHODS[method], n, 0.0, float(T), y0,
+                       has_jac, METHODS[method], n, 0.0, float(T), y0,
                        -1 if mode0 is None else int(mode0), p, dpw, system.directions, rtol, atol, 0.0, hmax,
                        int(max_steps), int(max_events), guard_tol, False, np.empty(0), False, int(stop_mode),
                        int(stop_count), 50, 1e-12 * T, out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f,

@@ -20,8 +20,9 @@ import numba
 import numpy as np
 from numba import types
 
-from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE, no_jacobian
+from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE, kernel_jacobian
 from . import _kernel as K
+from ._tableau import METHOD_DOP853
 
 # per-run float outputs
 B_T_END, B_T_FIRST_EVENT, B_T_IN_STOP = range(3)
@@ -155,13 +156,13 @@ def run_batch(system, X0, mode0, *, t_max: float, atol, rtol: float = 1e-12, met
     status = np.empty(m, dtype=np.int64)
     n_events = np.empty(m, dtype=np.int64)
     fout = np.empty((m, N_BFLOAT))
-    jac = system.jacobian if system.jacobian is not None else no_jacobian
+    jac, has_jac = kernel_jacobian(system, used=int(method) != METHOD_DOP853)   # the lean kernel never calls it
     kernel = K.kernel_for(int(method))
     batch = K.compile_for(batch_kernel, BATCH_SIG)
 
     def rows(lo: int, hi: int) -> None:
         batch(kernel, system.vector_field, system.guards, system.transition, jac, system.mode_of,
-              system.jacobian is not None, int(method), X0, mode0, float(t_max), system.params,
+              has_jac, int(method), X0, mode0, float(t_max), system.params,
               system.directions, float(rtol), atol, int(max_steps), int(max_events),
               guard_tol, int(stop_mode), int(stop_count), X_end, mode_end, status, n_events,
               fout, lo, hi)

@@ -56,9 +56,9 @@ def _put_row(dst, row, src):
     """dst[row, :] = src without the temporaries of slice assignment (the kernel runs without NRT).
 
     This and the kernel's other small helpers (``_put``, ``_guards_base``, ``_rhs_at``,
-    ``_dense_state``) are compiled once and called with LLVM's ``alwaysinline``
-    (``forceinline=True``) instead of numba's IR inlining, which copies, re-types and re-lowers a
-    helper at every call site (~20 sites). LLVM then inlines the calls, so the run time is the
+    ``_dense_state``, ``_guard_at``; also ``rhs`` and the steppers) are compiled once and called
+    with LLVM's ``alwaysinline`` (``forceinline=True``) instead of numba's IR inlining, which
+    copies, re-types and re-lowers a helper at every call site (~25 sites). LLVM then inlines the calls, so the run time is the
     same; without ``forceinline`` the calls stayed and simulations and event maps were 3-4 %
     slower."""
     for i in range(src.size):
@@ -97,7 +97,8 @@ def _dense_state(method, t_old, h, y_old, Q, t, out, full):
     dense_eval(method, t_old, h, y_old, Q, t, out, full)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+             forceinline=True)
 def _guard_at(guards, mode, t, t_old, h, y_old, Q, method, p, i, xs, xb, gs, full):
     dense_eval(method, t_old, h, y_old, Q, t, xs, full)
     _guards_base(guards, mode, t, xs, p, gs, xb)
@@ -198,58 +199,34 @@ def _scan_unarmed(guards, mode, i, d, tol, t, g0, t_new, g1, h, y_old, Q, method
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp, y_new, f_new,
-              err, full):
-    """One explicit step (DP5 or DOP853; ``full`` None: DOP853 only), compiled once for event
-    polishing. The main loop inlines the step itself (its hot path); a second inlined copy in
-    polishing doubled the kernel's compile time."""
-    if full is not None and method == METHOD_DP5:
-        return dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
-                        y_new, f_new, err, full)
-    return dop853_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K, ytmp,
-                       y_new, f_new, err, full)
-
-
-@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h, t_ev, p, rtol, atol,
-                  J, M, piv, Mr, pivr, Z, F3, R, K, ytmp, y_new, f_new, err, Q, xs, xb, gs, full):
-    """Newton on the step length he = t_ev - t with the guard's slope from the dense output.
-    On success xs holds the state at the returned event time; otherwise xs is left as the
-    dense-output state and t_ev is returned unchanged. Returns (t_ev, f evaluations)."""
-    n = x.size
+def _polish_slope(guards, mode, i_ev, t, h, t_ev, x, Q, method, p, xs, xb, gs, full):
+    """Slope of guard ``i_ev`` at the located event ``t_ev`` on the dense output of the step
+    (t, h), for the kernel's Newton iteration on the step length that ends on the guard.
+    Returns (polish, slope); polish is False when the slope cannot be taken."""
     delta = 1e-7 * h
     ta = max(t, t_ev - delta)
     tb = min(t + h, t_ev + delta)
-    ga = _guard_at(guards, mode, ta, t, h, x, Q, method, p, i_ev, ytmp, xb, gs, full)
-    gb = _guard_at(guards, mode, tb, t, h, x, Q, method, p, i_ev, ytmp, xb, gs, full)
+    ga = _guard_at(guards, mode, ta, t, h, x, Q, method, p, i_ev, xs, xb, gs, full)
+    gb = _guard_at(guards, mode, tb, t, h, x, Q, method, p, i_ev, xs, xb, gs, full)
     if tb <= ta or ga == gb:
-        return t_ev, 0
-    slope = (gb - ga) / (tb - ta)
-    he = t_ev - t
-    nfev = 0
-    for it in range(4):
-        # one step of size he from (t, x) into y_new with the method itself
-        if full is not None and method == METHOD_RADAU:
-            en, ok, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, J, M,
-                                    piv, Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err, full)
-            nfev += fe
-            if not ok:
-                return t_ev, nfev
-        else:
-            _explicit(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, he, p, rtol, atol, K, ytmp,
-                      y_new, f_new, err, full)
-            nfev += 12 if method == METHOD_DOP853 else 6
-        _guards_base(guards, mode, t + he, y_new, p, gs, xb)
-        dh = -gs[i_ev] / slope
-        if abs(dh) <= 4.0 * EPS * max(abs(t + he), 1e-300) or it == 3:
-            break
-        he_new = he + dh
-        if not (0.0 < he_new <= h) or abs(dh) > 1e-3 * h + abs(t_ev - t - he) * 10.0 + 1e-12 * h:
-            break
-        he = he_new
-    for i in range(n):
-        xs[i] = y_new[i]
-    return t + he, nfev
+        return False, 0.0
+    return True, (gb - ga) / (tb - ta)
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _polish_newton(guards, mode, i_ev, t, he, h, t_ev, slope, it, y_new, p, gs, xb):
+    """Newton iteration ``it`` (0..3) on the step length: the step of ``he`` from t ended at
+    y_new; the guard there over its slope at the event gives the correction. Returns (done,
+    next step length); done keeps he (converged, the last iteration, or a correction that
+    leaves the step or the dense output's neighbourhood of the event)."""
+    _guards_base(guards, mode, t + he, y_new, p, gs, xb)
+    dh = -gs[i_ev] / slope
+    if abs(dh) <= 4.0 * EPS * max(abs(t + he), 1e-300) or it == 3:
+        return True, he
+    he_new = he + dh
+    if not (0.0 < he_new <= h) or abs(dh) > 1e-3 * h + abs(t_ev - t - he) * 10.0 + 1e-12 * h:
+        return True, he
+    return False, he_new
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -431,18 +408,6 @@ def _make_kernel(full_flag):
         o += 16 * n
         Q = wf[o:o + 7 * n].reshape((7, n))
         o += 7 * n
-        J = wf[o:o + n * n].reshape((n, n))
-        o += n * n
-        M = wf[o:o + 9 * n * n].reshape((3 * n, 3 * n))
-        o += 9 * n * n
-        Mr = wf[o:o + n * n].reshape((n, n))
-        o += n * n
-        Z = wf[o:o + 3 * n].reshape((3, n))
-        o += 3 * n
-        F3 = wf[o:o + 3 * n].reshape((3, n))
-        o += 3 * n
-        R = wf[o:o + 3 * n]
-        o += 3 * n
         g_old = wf[o:o + ng]
         o += ng
         g_new = wf[o:o + ng]
@@ -456,32 +421,52 @@ def _make_kernel(full_flag):
         # from a step grown without bound in a mode whose flow the method integrates exactly (stick)
         h_mode = wf[o:o + n_modes]
         o += n_modes
-        yw = wf[o:o + nb]
-        o += nb
-        fw = wf[o:o + nb]
-        o += nb
-        fp = wf[o:o + nb]
-        o += nb
-        fm = wf[o:o + nb]
-        o += nb
-        fbm = wf[o:o + nb]
-        o += nb
-        fbp = wf[o:o + nb]
-        o += nb
-        gradh = wf[o:o + nb]
-        o += nb
-        xw = wf[o:o + nb]
-        o += nb
-        xw2 = wf[o:o + nb]
-        o += nb
-        Jw = wf[o:o + nb * nb].reshape((nb, nb))
-        o += nb * nb
-        Ssal = wf[o:o + nb * nb].reshape((nb, nb))
-        o += nb * nb
-        Rx = wf[o:o + nb * nb].reshape((nb, nb))
-        piv = wi[0:3 * n]
-        pivr = wi[3 * n:4 * n]
         armed = wi[4 * n:4 * n + ng]
+        if full is not None:
+            # Radau IIA, the variational equations and saltation matrices
+            J = wf[o:o + n * n].reshape((n, n))
+            o += n * n
+            M = wf[o:o + 9 * n * n].reshape((3 * n, 3 * n))
+            o += 9 * n * n
+            Mr = wf[o:o + n * n].reshape((n, n))
+            o += n * n
+            Z = wf[o:o + 3 * n].reshape((3, n))
+            o += 3 * n
+            F3 = wf[o:o + 3 * n].reshape((3, n))
+            o += 3 * n
+            R = wf[o:o + 3 * n]
+            o += 3 * n
+            yw = wf[o:o + nb]
+            o += nb
+            fw = wf[o:o + nb]
+            o += nb
+            fp = wf[o:o + nb]
+            o += nb
+            fm = wf[o:o + nb]
+            o += nb
+            fbm = wf[o:o + nb]
+            o += nb
+            fbp = wf[o:o + nb]
+            o += nb
+            gradh = wf[o:o + nb]
+            o += nb
+            xw = wf[o:o + nb]
+            o += nb
+            xw2 = wf[o:o + nb]
+            o += nb
+            Jw = wf[o:o + nb * nb].reshape((nb, nb))
+            o += nb * nb
+            Ssal = wf[o:o + nb * nb].reshape((nb, nb))
+            o += nb * nb
+            Rx = wf[o:o + nb * nb].reshape((nb, nb))
+            piv = wi[0:3 * n]
+            pivr = wi[3 * n:4 * n]
+        else:
+            # the lean kernel passes the right-hand side's work arrays to the steppers, which do
+            # not touch them without sensitivities: stand-ins of the same types, not 25 more
+            # slices to compile
+            yw = fw = fp = fm = ftmp
+            Jw = K
         for i in range(nz):
             zeno_times[i] = -np.inf
         for i in range(n_modes):
@@ -548,47 +533,89 @@ def _make_kernel(full_flag):
             nfev += 1
         n_small = 0
         rejected = False
+        # Event polishing re-enters this loop's one step: while `polishing`, each pass takes a step
+        # of he from (t, x) (a Newton iterate for the step that ends on the guard) instead of the
+        # next step, so the step is inlined once (a second copy for polishing doubled the compile).
+        polishing = False
+        he = 0.0
+        slope = 0.0
+        it_pol = ng - ng
+        tiny = 0.0
+        last = False
+        t_new = t
+        t_ev = np.inf
+        i_ev = ng - ng - 1   # -1, typed int64 (a literal compiled the helpers taking it twice)
+        ev_exact = True      # False for threshold events of unarmed guards (no polishing)
         while True:
-            remaining = t1 - t
-            if remaining <= 0.0:
-                status = _S_SUCCESS
-                break
-            if n_steps + n_rej >= max_steps:
-                status = _S_MAXSTEPS
-                break
-            if (not use_eval) and record_steps and cap_out - n_out < 3:
-                status = _S_FULL
-                break
-            if n_ev >= cap_ev:
-                status = _S_FULL
-                break
-            tiny = 8.0 * EPS * max(abs(t), 1e-300)
-            if h > hmax:
-                h = hmax
-            last = False
-            if h >= remaining - tiny:
-                h = remaining
-                last = True
-            if h <= tiny and not last:
-                status = _S_SMALL
-                break
+            if polishing:
+                hs = he
+            else:
+                remaining = t1 - t
+                if remaining <= 0.0:
+                    status = _S_SUCCESS
+                    break
+                if n_steps + n_rej >= max_steps:
+                    status = _S_MAXSTEPS
+                    break
+                if (not use_eval) and record_steps and cap_out - n_out < 3:
+                    status = _S_FULL
+                    break
+                if n_ev >= cap_ev:
+                    status = _S_FULL
+                    break
+                tiny = 8.0 * EPS * max(abs(t), 1e-300)
+                if h > hmax:
+                    h = hmax
+                last = False
+                if h >= remaining - tiny:
+                    h = remaining
+                    last = True
+                if h <= tiny and not last:
+                    status = _S_SMALL
+                    break
+                hs = h
+            conv = True
             if full is not None and method == METHOD_RADAU:
-                if not sens:
-                    if has_jac:
-                        jac(mode, t, x, p, J)
+                if not polishing:
+                    if not sens:
+                        if has_jac:
+                            jac(mode, t, x, p, J)
+                        else:
+                            numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
+                            nfev += n
                     else:
-                        numerical_jacobian(vf, mode, t, x, f, p, rtol, atol, J, ytmp, ftmp)
-                        nfev += n
-                else:
-                    # J_x into J's leading block: radau_step solves the variational stages with the
-                    # stage Jacobians itself
-                    for i in range(nb):
-                        xw[i] = x[i]
-                    nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, J, fbm, fbp, nb)
-                njac += 1
-                en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, J, M, piv,
-                                          Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err, full)
+                        # J_x into J's leading block: radau_step solves the variational stages with
+                        # the stage Jacobians itself
+                        for i in range(nb):
+                            xw[i] = x[i]
+                        nfev += jacobian_central_or_exact(vf, jac, has_jac, mode, t, xw, p, J, fbm, fbp, nb)
+                    njac += 1
+                en, conv, fe = radau_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, hs, p, rtol, atol, J,
+                                          M, piv, Mr, pivr, Z, F3, R, ytmp, y_new, f_new, err, full)
                 nfev += fe
+            else:
+                # inlined here (the hot path: a call passing ~25 array arguments cost 5-8 % per
+                # step). The lean kernel prunes the DP5 branch before inlining, so it never copies
+                # the DP5 step.
+                if full is not None and method == METHOD_DP5:
+                    en = dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, hs, p, rtol, atol, K,
+                                  ytmp, y_new, f_new, err, full)
+                else:
+                    en = dop853_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, hs, p, rtol, atol, K,
+                                     ytmp, y_new, f_new, err, full)
+                nfev += 12 if method == METHOD_DOP853 else 6
+            if polishing:
+                # a Radau step that does not converge leaves xs at the dense output's state
+                if conv:
+                    done, he_next = _polish_newton(guards, mode, i_ev, t, he, h, t_ev, slope, it_pol, y_new, p, gs, xb)
+                    if not done:
+                        he = he_next
+                        it_pol += 1
+                        continue
+                    _put(xs, y_new)
+                    t_ev = t + he
+                polishing = False
+            else:
                 if not conv:
                     n_rej += 1
                     h *= 0.5
@@ -596,75 +623,95 @@ def _make_kernel(full_flag):
                         status = _S_NEWTON
                         break
                     continue
-            else:
-                # inlined here (the hot path: a call passing ~25 array arguments cost 5-8 % per
-                # step); event polishing calls the compiled copy _explicit. The lean kernel prunes
-                # the DP5 branch before inlining, so it never copies the DP5 step.
-                if full is not None and method == METHOD_DP5:
-                    en = dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K,
-                                  ytmp, y_new, f_new, err, full)
-                else:
-                    en = dop853_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, h, p, rtol, atol, K,
-                                     ytmp, y_new, f_new, err, full)
-                nfev += 12 if method == METHOD_DOP853 else 6
-            finite = np.isfinite(en)
-            for i in range(n):
-                if not np.isfinite(y_new[i]) or not np.isfinite(f_new[i]):
-                    finite = False
-            if not finite:
-                n_rej += 1
-                n_small += 1
-                h *= 0.25
-                if h <= tiny or n_small > 60:
-                    status = _S_NONFINITE
-                    break
-                continue
-            if fixed:
-                en = 0.0
-            if en > 1.0:
-                n_rej += 1
-                rejected = True
-                h *= max(MIN_FACTOR, SAFETY * en ** expo)
-                if h <= tiny:
-                    status = _S_SMALL
-                    break
-                continue
-            n_small = 0
-            n_steps += 1
-            t_new = t1 if last else t + h
-            # ---- events on this step; dense output only when a guard or t_eval needs it
-            _guards_base(guards, mode, t_new, y_new, p, g_new, xb)
-            need_dense = use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new
-            for i in range(ng):
-                if (not armed[i]) or _fires(directions[mode, i], g_old[i], g_new[i], 0.0):
-                    need_dense = True
-            if full is not None and method == METHOD_RADAU:
-                radau_dense(Z, Q)
-            elif need_dense:
-                nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, y_new, f_new, h, p, K, ytmp, Q,
-                                       full)
-            t_ev = np.inf
-            i_ev = ng - ng - 1   # -1, typed int64 (a literal -1 made numba compile _polish_event twice)
-            ev_exact = True   # False for threshold events of unarmed guards (no polishing)
-            for i in range(ng):
-                d = directions[mode, i]
-                if armed[i]:
-                    if _fires(d, g_old[i], g_new[i], 0.0):
-                        tr = locate_root(guards, mode, i, 0.0, t, g_old[i], t_new, g_new[i], t, h, x, Q,
-                                         method, p, xs, xb, gs, full)
+                finite = np.isfinite(en)
+                for i in range(n):
+                    if not np.isfinite(y_new[i]) or not np.isfinite(f_new[i]):
+                        finite = False
+                if not finite:
+                    n_rej += 1
+                    n_small += 1
+                    h *= 0.25
+                    if h <= tiny or n_small > 60:
+                        status = _S_NONFINITE
+                        break
+                    continue
+                if fixed:
+                    en = 0.0
+                if en > 1.0:
+                    n_rej += 1
+                    rejected = True
+                    h *= max(MIN_FACTOR, SAFETY * en ** expo)
+                    if h <= tiny:
+                        status = _S_SMALL
+                        break
+                    continue
+                n_small = 0
+                n_steps += 1
+                t_new = t1 if last else t + h
+                # ---- events on this step; dense output only when a guard or t_eval needs it
+                _guards_base(guards, mode, t_new, y_new, p, g_new, xb)
+                need_dense = use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new
+                for i in range(ng):
+                    if (not armed[i]) or _fires(directions[mode, i], g_old[i], g_new[i], 0.0):
+                        need_dense = True
+                if full is not None and method == METHOD_RADAU:
+                    radau_dense(Z, Q)
+                elif need_dense:
+                    nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, y_new, f_new, h, p,
+                                           K, ytmp, Q, full)
+                t_ev = np.inf
+                i_ev = ng - ng - 1
+                ev_exact = True
+                for i in range(ng):
+                    d = directions[mode, i]
+                    if armed[i]:
+                        if _fires(d, g_old[i], g_new[i], 0.0):
+                            tr = locate_root(guards, mode, i, 0.0, t, g_old[i], t_new, g_new[i], t, h, x, Q,
+                                             method, p, xs, xb, gs, full)
+                            if tr < t_ev:
+                                t_ev = tr
+                                i_ev = i
+                                ev_exact = True
+                    else:
+                        tr, arm_end = _scan_unarmed(guards, mode, i, d, guard_tol, t, g_old[i], t_new,
+                                                    g_new[i], h, x, Q, method, p, xs, xb, gs, full)
                         if tr < t_ev:
                             t_ev = tr
                             i_ev = i
-                            ev_exact = True
-                else:
-                    tr, arm_end = _scan_unarmed(guards, mode, i, d, guard_tol, t, g_old[i], t_new,
-                                                g_new[i], h, x, Q, method, p, xs, xb, gs, full)
-                    if tr < t_ev:
-                        t_ev = tr
-                        i_ev = i
-                        ev_exact = arm_end
-                    armed[i] = arm_end
-            if i_ev >= 0:
+                            ev_exact = arm_end
+                        armed[i] = arm_end
+                if i_ev < 0:
+                    # ---- no event: accept the whole step
+                    while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new:
+                        _dense_state(method, t, h, x, Q, t_eval[i_eval], xs, full)
+                        out_t[n_out] = t_eval[i_eval]
+                        _put_row(out_x, n_out, xs)
+                        out_mode[n_out] = mode
+                        n_out += 1
+                        i_eval += 1
+                    t = t_new
+                    for i in range(n):
+                        x[i] = y_new[i]
+                        f[i] = f_new[i]
+                    for i in range(ng):
+                        g_old[i] = g_new[i]
+                    if record_steps and not use_eval:
+                        out_t[n_out] = t
+                        _put_row(out_x, n_out, x)
+                        out_mode[n_out] = mode
+                        n_out += 1
+                    if last:
+                        status = _S_SUCCESS
+                        break
+                    if fixed:
+                        h = h0
+                    elif en == 0.0:
+                        h *= 1.0 if rejected else MAX_FACTOR
+                    else:
+                        h *= min(1.0 if rejected else MAX_FACTOR, SAFETY * en ** expo)
+                        h_mode[mode] = h
+                    rejected = False
+                    continue
                 # output up to the event
                 while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_ev:
                     _dense_state(method, t, h, x, Q, t_eval[i_eval], xs, full)
@@ -675,123 +722,96 @@ def _make_kernel(full_flag):
                     i_eval += 1
                 _dense_state(method, t, h, x, Q, t_ev, xs, full)
                 if ev_exact and t_ev > t:
-                    # polish: integrate to the event with one step of the method itself, so the
-                    # event state has the method's order rather than its dense output's
-                    t_ev, fe = _polish_event(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, guards, method, mode, i_ev, t, x, f, h,
-                                             t_ev, p, rtol, atol, J, M, piv, Mr, pivr, Z, F3, R, K, ytmp,
-                                             y_new, f_new, err, Q, xs, xb, gs, full)
-                    nfev += fe
+                    # polish: integrate to the event with steps of the method itself (next passes
+                    # of the loop), so the event state has the method's order rather than its
+                    # dense output's
+                    polishing, slope = _polish_slope(guards, mode, i_ev, t, h, t_ev, x, Q, method, p, ytmp, xb, gs,
+                                                     full)
+                    if polishing:
+                        he = t_ev - t
+                        it_pol = ng - ng   # 0, typed int64 as i_ev
+                        continue
+            # ---- the event at t_ev (state xs): transition, logs, the next mode
+            for i in range(nb):
+                xb[i] = xs[i]
+            new_mode = reset(mode, i_ev, t_ev, xb, p, xb2)
+            for i in range(nb):
+                ytmp[i] = xb2[i]
+            if full is not None and sens and 0 <= new_mode < n_modes:
+                saltation(vf, guards, reset, mode, new_mode, i_ev, t_ev, xb, xb2, p, Ssal, fbm, fbp,
+                          gradh, xw, xw2, gs, Rx)
+                nfev += 2
                 for i in range(nb):
-                    xb[i] = xs[i]
-                new_mode = reset(mode, i_ev, t_ev, xb, p, xb2)
-                for i in range(nb):
-                    ytmp[i] = xb2[i]
-                if full is not None and sens and 0 <= new_mode < n_modes:
-                    saltation(vf, guards, reset, mode, new_mode, i_ev, t_ev, xb, xb2, p, Ssal, fbm, fbp,
-                              gradh, xw, xw2, gs, Rx)
-                    nfev += 2
+                    for j in range(m_sens):
+                        acc = 0.0
+                        for k in range(nb):
+                            acc += Ssal[i, k] * xs[nb + k * m_sens + j]
+                        ytmp[nb + i * m_sens + j] = acc
+                if m_sens > nb:
+                    # the event time moves with mu through g_mu; the reset moves with R_mu
+                    saltation_param(guards, reset, mode, i_ev, t_ev, xb, p, dpw, gs, xw2, fbm)
                     for i in range(nb):
-                        for j in range(m_sens):
-                            acc = 0.0
-                            for k in range(nb):
-                                acc += Ssal[i, k] * xs[nb + k * m_sens + j]
-                            ytmp[nb + i * m_sens + j] = acc
-                    if m_sens > nb:
-                        # the event time moves with mu through g_mu; the reset moves with R_mu
-                        saltation_param(guards, reset, mode, i_ev, t_ev, xb, p, dpw, gs, xw2, fbm)
-                        for i in range(nb):
-                            ytmp[nb + i * m_sens + nb] += fbp[i] * gs[0] + fbm[i]
-                elif full is not None and sens:
-                    for i in range(nb, n):
-                        ytmp[i] = xs[i]
-                ev_t[n_ev] = t_ev
-                _put_row(ev_xb, n_ev, xb)
-                _put_row(ev_xa, n_ev, xb2)
-                ev_guard[n_ev] = i_ev
-                ev_from[n_ev] = mode
-                ev_to[n_ev] = new_mode
-                n_ev += 1
-                n_ev_total += 1
-                if record_steps and not use_eval:
-                    out_t[n_out] = t_ev
-                    _put_row(out_x, n_out, xs)
-                    out_mode[n_out] = mode
-                    n_out += 1
-                t = t_ev
-                for i in range(n):
-                    x[i] = ytmp[i]
-                if new_mode < 0:
-                    status = _S_STOPPED
-                    break
-                if new_mode >= n_modes:
-                    status = _S_INVALID
-                    mode = new_mode
-                    break
-                mode = new_mode
-                if record_steps and not use_eval:
-                    out_t[n_out] = t
-                    _put_row(out_x, n_out, x)
-                    out_mode[n_out] = mode
-                    n_out += 1
-                # Zeno: zeno_count events within zeno_window, or zeno_count consecutive events of
-                # guards that never armed (the motion chatters inside the guard tolerance)
-                n_threshold = 0 if ev_exact else n_threshold + 1
-                if zeno_count > 0 and n_threshold >= zeno_count:
-                    status = _S_ZENO
-                    break
-                if zeno_count > 0:
-                    k = n_ev_total % zeno_count
-                    if t - zeno_times[k] < zeno_window:
-                        status = _S_ZENO
-                        break
-                    zeno_times[k] = t
-                if stop_mode >= 0 and mode == stop_mode:
-                    stop_hits += 1
-                    if stop_hits >= stop_count:
-                        status = _S_STOPPED
-                        break
-                if n_ev_total >= max_events:
-                    status = _S_MAXEVENTS
-                    break
-                nfev += 1 + _rhs_at(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f, full)
-                _guards_base(guards, mode, t, x, p, g_old, xb)
-                for i in range(ng):
-                    armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
-                if fixed:
-                    h = h0
-                else:
-                    h = min(h, h_mode[mode])
-                continue
-            # ---- no event: accept the whole step
-            while use_eval and i_eval < n_eval and t_eval[i_eval] <= t_new:
-                _dense_state(method, t, h, x, Q, t_eval[i_eval], xs, full)
-                out_t[n_out] = t_eval[i_eval]
+                        ytmp[nb + i * m_sens + nb] += fbp[i] * gs[0] + fbm[i]
+            elif full is not None and sens:
+                for i in range(nb, n):
+                    ytmp[i] = xs[i]
+            ev_t[n_ev] = t_ev
+            _put_row(ev_xb, n_ev, xb)
+            _put_row(ev_xa, n_ev, xb2)
+            ev_guard[n_ev] = i_ev
+            ev_from[n_ev] = mode
+            ev_to[n_ev] = new_mode
+            n_ev += 1
+            n_ev_total += 1
+            if record_steps and not use_eval:
+                out_t[n_out] = t_ev
                 _put_row(out_x, n_out, xs)
                 out_mode[n_out] = mode
                 n_out += 1
-                i_eval += 1
-            t = t_new
+            t = t_ev
             for i in range(n):
-                x[i] = y_new[i]
-                f[i] = f_new[i]
-            for i in range(ng):
-                g_old[i] = g_new[i]
+                x[i] = ytmp[i]
+            if new_mode < 0:
+                status = _S_STOPPED
+                break
+            if new_mode >= n_modes:
+                status = _S_INVALID
+                mode = new_mode
+                break
+            mode = new_mode
             if record_steps and not use_eval:
                 out_t[n_out] = t
                 _put_row(out_x, n_out, x)
                 out_mode[n_out] = mode
                 n_out += 1
-            if last:
-                status = _S_SUCCESS
+            # Zeno: zeno_count events within zeno_window, or zeno_count consecutive events of
+            # guards that never armed (the motion chatters inside the guard tolerance)
+            n_threshold = 0 if ev_exact else n_threshold + 1
+            if zeno_count > 0 and n_threshold >= zeno_count:
+                status = _S_ZENO
                 break
+            if zeno_count > 0:
+                k = n_ev_total % zeno_count
+                if t - zeno_times[k] < zeno_window:
+                    status = _S_ZENO
+                    break
+                zeno_times[k] = t
+            if stop_mode >= 0 and mode == stop_mode:
+                stop_hits += 1
+                if stop_hits >= stop_count:
+                    status = _S_STOPPED
+                    break
+            if n_ev_total >= max_events:
+                status = _S_MAXEVENTS
+                break
+            nfev += 1 + _rhs_at(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, p, f, full)
+            _guards_base(guards, mode, t, x, p, g_old, xb)
+            for i in range(ng):
+                armed[i] = _armed_state(directions[mode, i], g_old[i], guard_tol)
             if fixed:
                 h = h0
-            elif en == 0.0:
-                h *= 1.0 if rejected else MAX_FACTOR
             else:
-                h *= min(1.0 if rejected else MAX_FACTOR, SAFETY * en ** expo)
-                h_mode[mode] = h
-            rejected = False
+                h = min(h, h_mode[mode])
 
         info[I_STATUS] = status
         info[I_NOUT] = n_out
@@ -823,8 +843,13 @@ _DISPATCHERS = {"lean": numba.njit(**_OPTIONS)(_make_kernel(None)), "full": numb
 
 
 def compiled(kind: str):
-    """The kernel ``kind`` ("lean" or "full"), compiled for KERNEL_SIG on first use."""
-    return compile_for(_DISPATCHERS[kind], KERNEL_SIG)
+    """The kernel ``kind`` ("lean" or "full"), compiled for KERNEL_SIG on first use.
+
+    The lean kernel compiles without LLVM's loop vectorizer and unroller: its loops run over
+    the states of one system (3-4 for the presets), too few for vector code or unrolled copies,
+    which took ~1.3 s and ~1-2 s of its ~12 s compile at the same run time. The full kernel
+    keeps them (with sensitivities its loops run over n (n + 1) entries)."""
+    return compile_for(_DISPATCHERS[kind], KERNEL_SIG, small_loops=kind == "lean")
 
 
 def kernel_for(method: int):

@@ -14,7 +14,8 @@ EPS = np.finfo(np.float64).eps
 CBRT_EPS = float(np.cbrt(EPS))    # central-difference step factor, not recomputed per call (~5 % of a step)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@numba.njit(cache=True, error_model="numpy", _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+             forceinline=True)
 def rhs(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, y, p, out, full):
     """out = f(y) (plain) or [f(x), J(x) Phi (+ f_mu in the parameter column)] (augmented).
     Returns extra f evaluations.

@@ -7,9 +7,9 @@ import numpy as np
 
 from ..errors import ConvergenceError, Status, SystemDefinitionError, check_finite_positive, status_message
 from ..results import EventLog, Trajectory, make_status
-from ..system import PiecewiseSystem, no_jacobian
+from ..system import PiecewiseSystem, kernel_jacobian
 from . import _kernel as K
-from ._tableau import METHODS
+from ._tableau import METHOD_DOP853, METHODS
 
 
 #: the largest |x_i| a run starts from: cubes of the state stay finite in double precision
@@ -179,7 +179,7 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     cap_ev = min(int(max_events), 256)
     ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo = K.event_buffers(cap_ev, n)
     x_final = np.empty(n)
-    jac = system.jacobian if system.jacobian is not None else no_jacobian
+    jac, has_jac = kernel_jacobian(system, used=meth != METHOD_DOP853)   # the lean kernel never calls it
     nf, ni = K.workspace_sizes(n, n, system.n_guards, system.n_modes, int(zeno_count))
     wf, wi = np.empty(nf), np.empty(ni, dtype=np.int64)
     t_cur, x_cur, m_cur = t0, x0, m0
@@ -188,7 +188,7 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     for _ in range(10_000):
         steps_left = int(max_steps) - int(info[K.I_NSTEPS] + info[K.I_NREJ])
         kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
-               system.jacobian is not None, meth, n, t_cur, t1, x_cur, m_cur, p, K.NO_PARAM_DIRECTION,
+               has_jac, meth, n, t_cur, t1, x_cur, m_cur, p, K.NO_PARAM_DIRECTION,
                system.directions, rtol, atol, h0, hmax, steps_left, int(max_events),
                guard_tol, fixed, te, True, sm, int(stop_count), int(zeno_count), zw,
                out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to,

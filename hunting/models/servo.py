@@ -26,7 +26,8 @@ import numba
 import numpy as np
 
 from ..sliding import direction_from_rest
-from ..system import GUARD_SIG, JAC_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, PiecewiseSystem, compile_for
+from ..system import (GUARD_SIG, JAC_SIG, MODE_SIG, RESET_SIG, VF_SIG, Mode, PiecewiseSystem, compile_for,
+                      compile_later)
 from .friction import lugre_partials, lugre_rates, slip_force, stribeck_level_slope
 from .plant import cogging_force, cogging_slope, external_force
 
@@ -248,8 +249,11 @@ def build_servo_system(name: str, params: np.ndarray, *, odd: bool, units: dict)
     # compiled here, not at import: a command that never builds a preset loop (a user model,
     # `hunting models`, --help) does not pay the ~3 s of compiling these on a fresh install
     for fn, sig in ((servo_vf, VF_SIG), (servo_guards, GUARD_SIG), (servo_reset, RESET_SIG),
-                    (servo_mode_of, MODE_SIG), (servo_jac, JAC_SIG)):
-        compile_for(fn, sig)
+                    (servo_mode_of, MODE_SIG)):
+        compile_for(fn, sig, small_loops=True)
+    # the Jacobian only when a kernel calls it (Radau, sensitivities): not for simulations and
+    # event maps, which run the lean kernel
+    compile_later(servo_jac, JAC_SIG)
     model = int(params[MODEL])
     modes, guard_names, directions, mirror = MODE_TABLES[model]
     states = ("x1", "x2", "x3") + (("x4",) if model == MODEL_LUGRE else ())
