@@ -22,7 +22,6 @@ from numba import types
 
 from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE, kernel_jacobian
 from . import _kernel as K
-from ._tableau import METHOD_DOP853
 
 # per-run float outputs
 B_T_END, B_T_FIRST_EVENT, B_T_IN_STOP = range(3)
@@ -156,7 +155,7 @@ def run_batch(system, X0, mode0, *, t_max: float, atol, rtol: float = 1e-12, met
     status = np.empty(m, dtype=np.int64)
     n_events = np.empty(m, dtype=np.int64)
     fout = np.empty((m, N_BFLOAT))
-    jac, has_jac = kernel_jacobian(system, used=int(method) != METHOD_DOP853)   # the lean kernel never calls it
+    jac, has_jac = kernel_jacobian(system, used=K.calls_jacobian(int(method)))
     kernel = K.kernel_for(int(method))
     batch = K.compile_for(batch_kernel, BATCH_SIG)
 

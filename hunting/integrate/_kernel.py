@@ -856,7 +856,13 @@ def kernel_for(method: int):
     """The compiled kernel that runs ``method`` (METHOD_*) without sensitivities: the lean
     kernel for DOP853, else the full one (flows with sensitivities call ``integrate_kernel``;
     without them a flow runs as fast on either: 149 vs 161 us per period of table 9.1)."""
-    return compiled("lean" if method == METHOD_DOP853 else "full")
+    return compiled("full" if calls_jacobian(method) else "lean")
+
+
+def calls_jacobian(method: int) -> bool:
+    """Whether :func:`kernel_for` ``(method)`` may call the system's Jacobian: the lean kernel
+    (DOP853) never does, the full one does for Radau."""
+    return method != METHOD_DOP853
 
 
 def __getattr__(name: str):

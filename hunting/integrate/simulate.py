@@ -9,7 +9,7 @@ from ..errors import ConvergenceError, Status, SystemDefinitionError, check_fini
 from ..results import EventLog, Trajectory, make_status
 from ..system import PiecewiseSystem, kernel_jacobian
 from . import _kernel as K
-from ._tableau import METHOD_DOP853, METHODS
+from ._tableau import METHODS
 
 
 #: the largest |x_i| a run starts from: cubes of the state stay finite in double precision
@@ -179,7 +179,7 @@ def simulate(system: PiecewiseSystem, x0, t_span, *, method: str = "dop853", rto
     cap_ev = min(int(max_events), 256)
     ev_t, ev_xb, ev_xa, ev_g, ev_f, ev_to, info, finfo = K.event_buffers(cap_ev, n)
     x_final = np.empty(n)
-    jac, has_jac = kernel_jacobian(system, used=meth != METHOD_DOP853)   # the lean kernel never calls it
+    jac, has_jac = kernel_jacobian(system, used=K.calls_jacobian(meth))
     nf, ni = K.workspace_sizes(n, n, system.n_guards, system.n_modes, int(zeno_count))
     wf, wi = np.empty(nf), np.empty(ni, dtype=np.int64)
     t_cur, x_cur, m_cur = t0, x0, m0
