@@ -141,3 +141,22 @@ def test_saturation_coinciding_peaks_calibrated_on_sampled_replicas():
         u = u + 10 ** rng.uniform(-8, -1.5) * rng.standard_normal(t.size)
         ps.append(_saturation_p(u))
     assert np.mean(np.array(ps) < 0.01) == 0.0
+
+
+def test_saturation_pile_up_is_read_in_both_records():
+    """A machine that saturated only in its validation run (reporting6 d0311: 4 samples at the
+    bound in the fitting record, 2441 of 3426 in the validation one, nothing reported) is
+    saturated all the same: the excursions of both records are the trials. The fitting record
+    here peaks at 0.8 and never reaches the bound; the validation one is clipped at 1.0. Alone the
+    fitting record is no evidence; the pair is, at the validation record's level. The same record
+    given twice counts once."""
+    from types import SimpleNamespace
+    from hunting.diagnose.causes.saturation import evidence, records_output
+    t = np.arange(0.0, 6.0, 1e-3)
+    q = np.sin(t)
+    fit = SimpleNamespace(u=0.8 * np.sin(2 * np.pi * 0.7 * t), q=q, n=t.size)
+    val = SimpleNamespace(u=np.clip(1.6 * np.sin(2 * np.pi * 0.9 * t + 0.4), -1.0, 1.0), q=q + 1, n=t.size)
+    assert evidence(fit.u)[3] > 0.05
+    U, _, _, p = evidence(records_output(fit, val))
+    assert U == pytest.approx(1.0) and p < 1e-6
+    assert np.array_equal(records_output(fit, SimpleNamespace(u=fit.u.copy(), q=q.copy(), n=t.size)), fit.u)

@@ -85,6 +85,15 @@ def check_controller(meas: Measurement, model: NominalModel) -> str | None:
         if rest <= CONTROLLER_MISMATCH:
             return (f"{text}; without its saturation at {model.controller['saturation']:.4g} it is {rest:.1%}: the "
                     "saturation is what differs, and re-simulations clip u where the machine did not")
+    top = float(np.max(np.abs(meas.u)))
+    if top < model.controller.get("saturation", math.inf):
+        # the machine's output may be limited where the model's is not: clipped at the measured
+        # extreme, does the model's controller give the measured u?
+        clipped = controller_output(meas, dict(model.controller, saturation=top))
+        rest = float(np.sqrt(np.mean((clipped - meas.u) ** 2))) / size
+        if rest <= CONTROLLER_MISMATCH:
+            return (f"{text}; saturated at the measured extreme ±{top:.4g} it is {rest:.1%}: the machine's output is "
+                    "limited there and the model's is not (the saturation cause judges it)")
     return f"{text}: check the controller's {keys} and the sign and unit of u; re-simulations run a loop the machine did not"
 
 
