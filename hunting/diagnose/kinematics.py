@@ -208,7 +208,8 @@ def reference_kinematics(meas: Measurement, model, *, window: float | None = Non
                               window=window, resolution=0.0)
     still = Measurement(meas.t, meas.q_ref, np.zeros(meas.n), name=meas.name + " (reference)")
     k0 = kinematics(still, model.cm, window=window, resolution=0.0)
-    drive = model.mass * k0.a_inst + model.friction(k0.vf) + model.offset + model.cogging_force(meas.q_ref)
+    drive = (model.mass * k0.a_inst + model.friction(k0.vf) + model.bristle_force(k0.vf, k0.dt) + model.offset
+             + model.cogging_force(meas.q_ref))
     return kinematics(replace(still, u=drive / model.cm), model.cm, window=window, resolution=0.0)
 
 
@@ -267,7 +268,7 @@ def residual(kin: Kinematics, model) -> np.ndarray:
     a two-sample delay)."""
     s = kin.slide
     cog = model.cogging_force(kin.q)
-    sliding = model.friction(kin.vf) + model.lag_force(kin.vf, kin.slide, kin.dt)
+    sliding = model.friction(kin.vf) + model.lag_force(kin.vf, kin.slide, kin.dt) + model.bristle_force(kin.vf, kin.dt)
     if model.flexibility is not None:
         sliding = sliding + model.flexibility.force(kin.a_inst, kin.dt)
     drive = kin.delayed_drive(model.delay)

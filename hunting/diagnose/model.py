@@ -251,6 +251,17 @@ class NominalModel:
         g = self.lagged_level(v, slide, dt, 0.0)
         return np.where(slide, np.sign(v) * (L - g), 0.0)
 
+    def bristle_force(self, v, dt: float) -> np.ndarray:
+        """LuGre's change of the sliding friction force from the static curve [N] (n,) along the
+        velocity v (n,) [m/s] sampled every dt [s] (:func:`hunting.diagnose.bristles.bristle_change`:
+        the bristles' lag, sigma0 z + sigma1 z' - sign(v) g(|v|), an inertia-like force where the
+        curve has a slope and presliding after reversals); zeros for the static laws."""
+        v = np.asarray(v, dtype=float)
+        if self.law != "lugre":
+            return np.zeros_like(v)
+        from .bristles import bristle_change
+        return bristle_change(v, dt, self.curve, self.sigma0, self.sigma1)
+
     def v_stick(self) -> float:
         """Speed [m/s] below which this model's mass counts as stuck when judging data: a tenth
         of the smaller Stribeck velocity (0 for curves without a Stribeck dip)."""

@@ -5,8 +5,8 @@ rests).
 
 A force-channel cause with sigma0 as hyper-parameter (a logarithmic grid of 25 slip lengths
 Fc / sigma0 from 5 mm down to two counts of the model's sensor resolution, or 0.1 um): the LuGre bristle state is integrated along the
-measured velocity (exactly for piecewise-constant v:
-z <- z_ss + (z - z_ss) exp(-sigma0 |v| dt / g), z_ss = sign(v) g / sigma0, g the nominal
+measured velocity (over the slip, with v linear between samples:
+:func:`hunting.diagnose.bristles.bristle_change`; z_ss = sign(v) g / sigma0, g the nominal
 Stribeck level of that direction), and the regressor is the change of the friction force
 sigma0 z + sigma1 z' - sign(v) g(|v|) (right after a reversal z' = 2 v, and the bristle damping
 dominates the transient). Its coefficient ``scale`` is 1 for LuGre: the whole level builds up
@@ -26,7 +26,6 @@ they are the extension's, which builds up the whole level, and the scale, re-est
 says how far the data's build-up is from LuGre's.
 
 The extension is the LuGre law with that sigma0 and sigma1 on the nominal curves."""
-import numba
 import numpy as np
 
 from . import presliding
@@ -42,21 +41,6 @@ SCALE_RANGE = (0.3, 3.0)
 ZETA_STARTS = (0.2, 1.0)      # the refinement's other starting damping ratios (the search holds ZETA)
 ZETA_RANGE = (0.05, 5.0)      # damping ratios of the presliding resonance the refinement may reach
 EXTENSION_COEFFICIENTS = (1.0,)   # the extension builds up the whole level: sigma0, zeta are refined at scale 1
-
-
-@numba.njit(cache=True)
-def _bristle(v, dt, g_pos, g_neg, sigma0):
-    """LuGre bristle deflection z [m] (n,) along the velocity v (n,) [m/s] sampled at dt, with
-    the steady levels g_pos, g_neg (n,) [N] of each direction, from the steady state of the
-    first sample's direction."""
-    z = np.empty(v.size)
-    zk = (g_pos[0] if v[0] >= 0.0 else -g_neg[0]) / sigma0
-    for k in range(v.size):
-        g = g_pos[k] if v[k] >= 0.0 else g_neg[k]
-        z_ss = (g if v[k] >= 0.0 else -g) / sigma0
-        zk = z_ss + (zk - z_ss) * np.exp(-sigma0 * abs(v[k]) * dt / g)
-        z[k] = zk
-    return z
 
 
 def hypers(kin, model) -> list:
@@ -97,16 +81,9 @@ def untestable(kin, model) -> str | None:
 
 
 def design(kin, model, hyper):
-    v = kin.vf
-    a = np.abs(v)
-    g_pos = model.curve.positive.level(a)
-    g_neg = model.curve.negative.level(a)
-    s0 = hyper["sigma0"]
-    s1 = _sigma1(hyper, model)
-    g = np.where(v >= 0, g_pos, g_neg)
-    z = _bristle(np.ascontiguousarray(v), float(kin.t[1] - kin.t[0]), g_pos, g_neg, s0)
-    zdot = v - s0 * a * z / g
-    return kin.sliding(s0 * z + s1 * zdot - np.sign(v) * g)[:, None]
+    from ..bristles import bristle_change
+    change = bristle_change(kin.vf, float(kin.t[1] - kin.t[0]), model.curve, hyper["sigma0"], _sigma1(hyper, model))
+    return kin.sliding(change)[:, None]
 
 
 RATIO_SHOWN = 10.0     # fitted scales above this are not quoted: LuGre's change there is too small to compare with

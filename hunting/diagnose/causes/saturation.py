@@ -168,7 +168,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     beyond the model's level at the largest measured |u| of both records (the final value; its
     change against the model's level the increment)."""
     from ..resimulate import position_rms_error
-    U, top, hits, p = evidence(records_output(fit, validate))
+    both = records_output(fit, validate)
+    U, top, hits, p = evidence(both)
     out = dict(statistic=float(hits), p_value=p)
     sat = model_level(model)
     _, above = beyond(fit.u, sat)
@@ -183,8 +184,9 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
                                 f"{np.max(np.abs(fit.u)):.4g}); "
                                 "the validation data go beyond it (see the note), which cannot set a level it is judged on")
     elif top < MIN_AT_BOUND or U <= 0:
-        return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its extreme "
-                                "in the two records)")
+        where = " in the two records" if both.size > fit.u.size else ""
+        return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its "
+                                f"extreme{where})")
     elif abs(sat - U) <= 0.01 * U:
         return dict(out, reason=f"the model already saturates at {sat:.4g}")
     if not can_sim:
