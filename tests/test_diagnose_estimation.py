@@ -209,3 +209,31 @@ def test_creep_error_removes_each_segment_mean():
     expect = np.sqrt(np.sum((ramp - ramp.mean()) ** 2) / 40)
     assert creep_error(sim, q, segs) == pytest.approx(expect, rel=1e-12)
     assert creep_error(sim[:5], q, segs) == float("inf")
+
+
+@pytest.mark.parametrize("controller, m, cm, b", [
+    ({"type": "pid", "kp": 1707.7, "kd": 114.6, "ki": 8149.4}, 12.35, 4.79, 49.3),           # reporting6 d0425
+    ({"type": "pid", "kp": 33.76, "kd": 1.656, "ki": 307.9, "tau_f": 0.00313}, 0.691, 26.2, 17.7),  # d0018
+    ({"type": "pd-velocity-loop", "kp": 40.0, "kv": 3.0}, 12.35, 4.79, 2.0)])
+def test_delay_margin_agrees_with_python_control(controller, m, cm, b):
+    """The nominal loop's delay margin (phase margin over crossover) against python-control's
+    stability_margins on the same continuous loop, within 0.5 %; a fitted delay beyond it is not
+    physical (reporting6 d0425: a 71 ms 'delay' on a one-way record whose loop has a 29 ms
+    margin) and one below it is."""
+    import control
+    from hunting.diagnose.causes import delay
+    from hunting.diagnose.guards import delay_margin
+    model = NominalModel.from_dict({"plant": {"mass": m, "motor_constant": cm},
+                                    "friction": {"law": "coulomb-viscous", "Fc": 15.0, "b": b},
+                                    "controller": controller})
+    s = control.tf("s")
+    if controller["type"] == "pid":
+        C = controller["kp"] + controller["ki"] / s + controller["kd"] * s / (controller.get("tau_f", 0.0) * s + 1)
+    else:
+        C = controller["kv"] * (controller["kp"] + s)
+    _, pm, _, _, wgc, _ = control.stability_margins(C * cm / (m * s ** 2 + b * s))
+    want = np.radians(pm) / wgc
+    got = delay_margin(model)
+    assert got == pytest.approx(want, rel=5e-3)
+    assert "delay margin" in delay.unphysical([1.2 * want], {}, model)
+    assert delay.unphysical([0.8 * want], {}, model) is None
