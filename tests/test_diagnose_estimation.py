@@ -237,3 +237,21 @@ def test_delay_margin_agrees_with_python_control(controller, m, cm, b):
     assert got == pytest.approx(want, rel=5e-3)
     assert "delay margin" in delay.unphysical([1.2 * want], {}, model)
     assert delay.unphysical([0.8 * want], {}, model) is None
+
+
+@pytest.mark.parametrize("family, index, bristles", [("reporting6", 216, False), ("reporting6", 251, False),
+                                                     ("reporting6", 337, True), ("tuning", 160, True)])
+def test_presliding_needs_creep_that_follows_the_force(family, index, bristles):
+    """Clean records whose mass slides slowly or slips where the nominal model sticks (reporting6
+    d0216, d0251: presliding was reported) move against the force changes; LuGre records
+    (reporting6 d0337, tuning d0160) creep with them, the quasi-static regressor explaining
+    more than 99 % of the motion."""
+    from hunting.diagnose.causes import presliding
+    from hunting.diagnose.select import default_window
+    fit, val, model, truth = _dataset(family, index)
+    assert ("reversal" in truth["causes"]) == bristles
+    kin = kinematics(fit, model.cm, window=default_window(fit, val, model), resolution=model.resolution,
+                     noise=model.sensor_noise)
+    segs = presliding.segments(kin, model)
+    why = presliding.not_following(kin, model, segs)
+    assert (why is None) == bristles, why

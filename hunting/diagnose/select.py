@@ -523,6 +523,9 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
         return None, (row if reason is None else dict(row, reason=reason)), model
     if p >= alpha:
         return reject(reason="no motion beyond quantization and sensor noise where the model sticks")
+    why = mod.not_following(kf, model, segs) if hasattr(mod, "not_following") else None
+    if why:
+        return reject(reason=why)
     theta = mod.fit_behaviour(fit, model, segs)[0] if can_sim else mod.fit_quasistatic(kf, model, segs)
     why = mod.at_bound(theta, fit, model) if hasattr(mod, "at_bound") else None
     if why:
