@@ -255,3 +255,21 @@ def test_presliding_needs_creep_that_follows_the_force(family, index, bristles):
     segs = presliding.segments(kin, model)
     why = presliding.not_following(kin, model, segs)
     assert (why is None) == bristles, why
+
+
+def test_an_offset_on_a_one_way_record_is_said_to_be_a_level_too():
+    """reporting6 d0369: a Coulomb level 30 % low (-1.58 N) on a record that moves one way only,
+    reported as an offset of -1.57 N; the level cause cannot be tested there. The report says
+    the offset is the same force as a level 1.57 N lower in that direction; moving the other
+    way, the same offset is a level that much higher. Nothing is said without the untested level."""
+    from types import SimpleNamespace
+    from hunting.diagnose.select import Cause, one_way_offset
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 5.37, "b": 1.0}})
+    off = Cause("offset", 0.5, 10.0, 1e-9, {"offset": -1.57}, {"offset": 0.01}, {})
+    why = [{"name": "level", "reason": "the record moves one way only (0% of the sliding samples the other way): ..."}]
+    kin = SimpleNamespace(v=np.full(100, 0.02), moving=np.ones(100, bool))
+    note, = one_way_offset([off], why, model, kin)
+    assert "(positive)" in note and "1.57 N lower" in note
+    kin.v = -kin.v
+    assert "1.57 N higher" in one_way_offset([off], why, model, kin)[0]
+    assert one_way_offset([off], [], model, kin) == []

@@ -272,6 +272,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     # one ranking over the channels: the relative worsening of each cause's own validation metric
     # without it
     result.sort(key=lambda c: -c.score)
+    notes += one_way_offset(result, untested, model, kf)
     view, sims = None, None
     if behaviour and model.controller is not None and validate.q_ref is not None:
         tick("behaviour view")
@@ -288,6 +289,25 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
                      fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
                      fc["explanations"])
+
+
+def one_way_offset(result: list, untested: list, model: NominalModel, kin: Kinematics) -> list:
+    """A note (list of str) when an offset is reported on a record that moves one way only
+    against a curve without a Stribeck dip (the level cause untested for that): there a constant
+    force and a change of the Coulomb level in that direction are the same force, and the data
+    cannot say which (reporting6 d0369: a level 30 % low, reported as an offset of -1.57 N, the
+    level's change -1.58 N)."""
+    off = next((c for c in result if c.name == "offset"), None)
+    if off is None or not any(u["name"] == "level" and "moves one way only" in u["reason"] for u in untested):
+        return []
+    from .causes._words import _q
+    F0 = off.parameters["offset"] - model.offset
+    way = 1.0 if np.mean(kin.v[kin.moving]) >= 0 else -1.0
+    # sliding the force against the motion is way (Fc + offset): the offset changes that level by way F0
+    return [f"the fitting record moves one way only ({'positive' if way > 0 else 'negative'}): its offset change of "
+            f"{_q(F0, None, 'N')} is, while it slides, the same force as a Coulomb level {_q(abs(F0), None, 'N')} "
+            f"{'higher' if way * F0 > 0 else 'lower'} in that direction (or a viscous force changed by that much at "
+            "its speed); a record that moves both ways tells them apart"]
 
 
 def worse_resimulation(view: dict) -> list:
