@@ -158,8 +158,13 @@ def _ls(t, e, tau) -> tuple[float, np.ndarray]:
 
 
 def _fit(t, e):
-    """Best (ss, [level, gain], time) over the time grid, and the constant-only ss."""
-    grid = np.geomspace(0.2 * t.min(), 5 * t.max(), 41)
+    """Best (ss, [level, gain], time) over the time grid, and the constant-only ss. The grid
+    starts at the shortest rest: a growth that completes before any rest ends is a level, and a
+    time below it let level and gain run off together (tuning d0237: level -72 N, gain 74 N, time
+    6 ms for a true 1.9 N over 32 ms; from the shortest rest 0.5, 1.4 N and 29 ms; the gain's
+    median error on the 40 testable dwell records of tuning, reporting5 and reporting6 2.8 ->
+    0.63 times the truth)."""
+    grid = np.geomspace(t.min(), 5 * t.max(), 41)
     ss, th, tau = min(((*_ls(t, e, x), float(x)) for x in grid), key=lambda r: r[0])
     return (ss, th, tau), float(np.sum((e - e.mean()) ** 2))
 
