@@ -273,3 +273,15 @@ def test_an_offset_on_a_one_way_record_is_said_to_be_a_level_too():
     kin.v = -kin.v
     assert "1.57 N higher" in one_way_offset([off], why, model, kin)[0]
     assert one_way_offset([off], [], model, kin) == []
+
+
+def test_force_channel_needs_three_windows_of_sliding():
+    """tuning-clean d0108: the validation record slides for 0.6 smoothing windows (29 ms of used
+    samples over a 48 ms window), and a 'viscous' was judged there and reported on clean data.
+    The force channel is skipped with the reason, naming both numbers."""
+    fit, val, model, truth = _dataset("tuning-clean", 108)
+    assert truth["causes"] == []
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == []
+    note = next(n for n in d.notes if n.startswith("force channel skipped"))
+    assert "span 0.6 filter windows (0.0483 s)" in note and "fewer than 3" in note

@@ -213,7 +213,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
     untested: list = []
     tick("force channel")
-    if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100:
+    windows = min(k.moving.sum() * k.dt / k.window for k in (kf, kv))
+    if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100 and windows >= MIN_WINDOWS:
         step = max(1, int(round(kf.window / fit.dt)) // 3)
         kr = reference_kinematics(validate, model, window=window)
         kfr = reference_kinematics(fit, model, window=window) if kr is not None else None
@@ -229,7 +230,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     else:
         if force_names:
             why = ("fewer than 100 sliding samples (|v| > 2 % of the maximum, half a filter window from stops and "
-                   "where the friction map is not too steep to evaluate) in the fitting or validation data")
+                   "where the friction map is not too steep to evaluate) in the fitting or validation data"
+                   if min(kf.moving.sum(), kv.moving.sum()) < 100 else
+                   f"the sliding samples span {windows:.1f} filter windows ({kf.window:.3g} s) in the fitting or "
+                   f"validation data, fewer than {MIN_WINDOWS}: the smoothed residual has about that many independent "
+                   "values")
             notes.append(f"force channel skipped: {why}")
             untested += [dict(name=n, reason=why) for n in force_names]
         fc = dict(causes=[], nominal=None, extended=None, rejected=[], alternatives=[], explanations=[], model=model,
@@ -325,6 +330,12 @@ def worse_resimulation(view: dict) -> list:
     return out
 
 
+# the force channel needs the used samples of each record to span this many smoothing windows:
+# the residual is smoothed over one, so it has about that many independent values (tuning-clean
+# d0108: a "viscous" judged on a validation record whose used samples span 0.6 windows; on tuning,
+# tuning-clean, reporting5 and reporting6 the records under 3 windows held one true force cause,
+# that false alarm and one wrong cause)
+MIN_WINDOWS = 3
 WINDOW_CYCLES = 0.5      # the smoothing window, in periods of the loop's bandwidth (at least 31 samples)
 
 
