@@ -222,7 +222,7 @@ def test_delay_margin_agrees_with_python_control(controller, m, cm, b):
     margin) and one below it is."""
     import control
     from hunting.diagnose.causes import delay
-    from hunting.diagnose.guards import delay_margin
+    from hunting.diagnose.loop import delay_margin
     model = NominalModel.from_dict({"plant": {"mass": m, "motor_constant": cm},
                                     "friction": {"law": "coulomb-viscous", "Fc": 15.0, "b": b},
                                     "controller": controller})

@@ -73,7 +73,8 @@ def run(args, results) -> int:
     fit = load(args.data, names)
     val = load(args.validate, names) if args.validate else None
     if val is not None:
-        from ..diagnose.guards import SAME_DATA_NOTE, same_record
+        from ..diagnose.data import same_record
+        from ..diagnose.guards import SAME_DATA_NOTE
         if same_record(fit, val):
             print(f"warning: {SAME_DATA_NOTE.format(args.validate)}", file=sys.stderr)
     bar = tqdm(total=1, desc="diagnose", file=sys.stderr, disable=not sys.stderr.isatty(), leave=False,

@@ -175,3 +175,9 @@ def save_csv(meas: Measurement, path) -> None:
     cols = [k for k in REQUIRED + OPTIONAL if getattr(meas, k) is not None]
     data = np.column_stack([getattr(meas, k) for k in cols])
     np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+
+
+def same_record(a: Measurement, b: Measurement) -> bool:
+    """Whether two measurements hold the same samples (q and u equal, whatever their names or
+    time origins): validation on them would not be out of sample."""
+    return a.n == b.n and np.array_equal(a.q, b.q) and np.array_equal(a.u, b.u)

@@ -10,68 +10,11 @@ import numpy as np
 
 from ..errors import SystemDefinitionError
 from .data import Measurement
+from .loop import loop_bandwidth
 from .model import NominalModel
 
 MIN_RATE_RATIO = 10.0      # the sample rate must exceed the loop bandwidth this many times
 MAX_FORCE_RATIO = 30.0     # the model's inertia or friction force against the measured drive force
-
-
-def loop_bandwidth(model: NominalModel) -> float | None:
-    """The closed loop's bandwidth [Hz] from the controller's gains and the mass (None without a
-    controller): the larger of the stiffness frequency sqrt(kp cm / m) and the damping rate
-    kd cm / m of a PID (2 pi rad/s per Hz), or of kv cm / m and kp for the PD + velocity loop."""
-    c = model.controller
-    if not c:
-        return None
-    from .resimulate import SampledController
-    ctrl = SampledController.from_schema(c)
-    m, cm = model.mass, model.cm
-    if ctrl.kind == "pd-velocity-loop":
-        w = max(abs(ctrl.kv) * cm / m, abs(ctrl.kp))
-    else:
-        w = max(math.sqrt(abs(ctrl.kp) * cm / m), abs(ctrl.kd) * cm / m)
-    return w / (2 * math.pi) if w > 0 else None
-
-
-def delay_margin(model: NominalModel) -> float | None:
-    """The delay [s] that would take the nominal loop to the edge of stability: its phase margin
-    over the crossover frequency, the smallest over the crossovers, for the linear loop of the
-    model's controller (a PID with its derivative filter, or the PD + velocity loop, taken
-    continuous) and the plant cm / (m s^2 + b s) (b the mean viscous coefficient; Coulomb friction
-    has no linear part). None without a controller, without a crossover in 1e-3..1e6 rad/s, or
-    when the loop has no positive margin already (its linear part says nothing then)."""
-    c = model.controller
-    if not c:
-        return None
-    from scipy.signal import freqs
-    from .resimulate import SampledController
-    ctrl = SampledController.from_schema(c)
-    b = max(0.5 * (model.curve.positive.b + model.curve.negative.b), 0.0)
-    plant_num, plant_den = [model.cm], [model.mass, b, 0.0]
-    if ctrl.kind == "pd-velocity-loop":
-        c_num, c_den = [ctrl.kv, ctrl.kv * ctrl.kp], [1.0]
-    else:
-        tf = max(ctrl.tau_f, 0.0)
-        # kp + ki / s + kd s / (tf s + 1) over the common denominator s (tf s + 1)
-        c_num = np.polyadd(np.polyadd(np.polymul([ctrl.kp, 0.0], [tf, 1.0]), np.polymul([ctrl.ki], [tf, 1.0])),
-                           [ctrl.kd, 0.0, 0.0])
-        c_den = np.polymul([1.0, 0.0], [tf, 1.0])
-    w = np.geomspace(1e-3, 1e6, 2000)
-    _, L = freqs(np.polymul(c_num, plant_num), np.polymul(c_den, plant_den), worN=w)
-    mag = np.abs(L)
-    cross = np.flatnonzero((mag[:-1] - 1.0) * (mag[1:] - 1.0) < 0)
-    if cross.size == 0:
-        return None
-    margins = []
-    for k in cross:
-        f = np.log(mag[k]) / (np.log(mag[k]) - np.log(mag[k + 1]))         # log-linear between grid points
-        wc = float(np.exp(np.log(w[k]) + f * (np.log(w[k + 1]) - np.log(w[k]))))
-        phase = float(np.angle(L[k] + f * (L[k + 1] - L[k])))
-        pm = math.remainder(math.pi + phase, 2 * math.pi)                     # in (-pi, pi]
-        if pm <= 0:
-            return None
-        margins.append(pm / wc)
-    return float(min(margins))
 
 
 def check_inputs(fit: Measurement, validate: Measurement, model: NominalModel) -> list:
@@ -158,12 +101,6 @@ def check_saturation(records, model: NominalModel) -> str | None:
 
 SAME_DATA_NOTE = ("the validation data are the fitting data ({}): the out-of-sample test then runs on the fitting data "
                   "and is not out of sample; give a separate record with --validate (or none: the last 40 % of DATA)")
-
-
-def same_record(a: Measurement, b: Measurement) -> bool:
-    """Whether two measurements hold the same samples (q and u equal, whatever their names or
-    time origins): validation on them would not be out of sample."""
-    return a.n == b.n and np.array_equal(a.q, b.q) and np.array_equal(a.u, b.u)
 
 
 def check_units(kin, model: NominalModel, name: str) -> None:

@@ -176,7 +176,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .force import Library
-    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_saturation, check_units, same_record
+    from .data import same_record
+    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_saturation, check_units
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -344,7 +345,7 @@ def default_window(fit: Measurement, validate: Measurement, model: NominalModel)
     longer (fast sampling: the acceleration's noise falls as the fifth power of the window, and
     with it what feedback of that noise puts into the regressors), at most a quarter of the
     shorter record."""
-    from .guards import loop_bandwidth
+    from .loop import loop_bandwidth
     dt = fit.dt
     f_bw = loop_bandwidth(model)
     w = 31 * dt if not f_bw else max(31 * dt, WINDOW_CYCLES / f_bw)

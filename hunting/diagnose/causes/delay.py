@@ -36,7 +36,7 @@ def unphysical(theta, hyper, model) -> str | None:
     d = model.delay + float(theta[0])
     if d < 0:
         return f"delay = {d:.3g} s < 0 (the plant would act before the command)"
-    from ..guards import delay_margin
+    from ..loop import delay_margin
     top = delay_margin(model)
     if top is not None and d > top:
         # a data record of a loop that tracks its reference is not one that a delay beyond its

@@ -154,7 +154,7 @@ def records_output(fit, validate) -> np.ndarray:
     saturated only in the validation run (reporting6 d0311: 4 samples at the bound in the fitting
     record, 2441 of 3426 in the validation one) is saturated all the same. The fitting record alone
     when the two are the same samples (pooling would count each excursion twice)."""
-    from ..guards import same_record
+    from ..data import same_record
     if same_record(fit, validate):
         return np.asarray(fit.u, dtype=float)
     return np.concatenate([np.asarray(fit.u, dtype=float), [0.0], np.asarray(validate.u, dtype=float)])
