@@ -81,7 +81,9 @@ def bristle_change(v: np.ndarray, dt: float, curve, sigma0: float, sigma1: float
     first sample's direction (positive at v = 0)."""
     v = np.ascontiguousarray(v, dtype=float)
     speed = np.abs(v)
-    g_pos, g_neg = curve.positive.level(speed), curve.negative.level(speed)
+    # a level of zero (no Coulomb friction) has no bristles to deflect: a floor keeps lam > 0
+    g_pos = np.maximum(curve.positive.level(speed), 1e-12)
+    g_neg = np.maximum(curve.negative.level(speed), 1e-12)
     z = bristle_state(v, float(dt), g_pos / sigma0, g_neg / sigma0,
                       float(g_pos[0] / sigma0 if v.size and v[0] >= 0 else -(g_neg[0] / sigma0 if v.size else 0.0)))
     g = np.where(v >= 0, g_pos, g_neg)
