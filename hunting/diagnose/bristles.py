@@ -80,12 +80,14 @@ def bristle_change(v: np.ndarray, dt: float, curve, sigma0: float, sigma1: float
     and the bristle stiffness sigma0 [N/m] and damping sigma1 [N s/m]. Starts settled in the
     first sample's direction (positive at v = 0)."""
     v = np.ascontiguousarray(v, dtype=float)
+    if v.size == 0:
+        return np.zeros(0)
     speed = np.abs(v)
     # a level of zero (no Coulomb friction) has no bristles to deflect: a floor keeps lam > 0
     g_pos = np.maximum(curve.positive.level(speed), 1e-12)
     g_neg = np.maximum(curve.negative.level(speed), 1e-12)
-    z = bristle_state(v, float(dt), g_pos / sigma0, g_neg / sigma0,
-                      float(g_pos[0] / sigma0 if v.size and v[0] >= 0 else -(g_neg[0] / sigma0 if v.size else 0.0)))
+    z_start = g_pos[0] / sigma0 if v[0] >= 0 else -g_neg[0] / sigma0
+    z = bristle_state(v, float(dt), g_pos / sigma0, g_neg / sigma0, float(z_start))
     g = np.where(v >= 0, g_pos, g_neg)
     zdot = v - sigma0 * speed * z / g
     return sigma0 * z + sigma1 * zdot - np.sign(v) * g

@@ -85,7 +85,7 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
         # decides only when that force is small)
         Fs = min(model.curve.positive.Fs, model.curve.negative.Fs)
         F_end = float(icpt + slope * (n_fit - 1))
-        sd.append(np.sign(F_end) if abs(F_end) > 0.5 * Fs else np.sign(meas.q[m] - q_rest))
+        s_k = float(np.sign(F_end) if abs(F_end) > 0.5 * Fs else np.sign(meas.q[m] - q_rest))
         # the position leaves the rest's band only some time D after the break-away, and the
         # force has ramped on meanwhile: read it D before the middle of the last still interval,
         # D the time the mass needs to cover the band from rest, driven by the ramp and by the
@@ -93,15 +93,15 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
         # about Fs). D and the reading are solved together by fixed-point passes from no excess:
         # each pass reads later and higher, so they rise monotonically to the fixed point (with
         # the ramp alone a grown break-away force was read low)
-        toward = max(sd[-1] * slope, 0.0) / dt          # [N/s] the ramp toward the motion
-        Fs_dir = (model.curve.positive if sd[-1] > 0 else model.curve.negative).Fs
+        toward = max(s_k * slope, 0.0) / dt          # [N/s] the ramp toward the motion
+        Fs_dir = (model.curve.positive if s_k > 0 else model.curve.negative).Fs
         x_end = n_fit - 1.0
         x_min = -float(min(k_end - n_fit + 1 - a, 3 * n_fit))     # within the rest: the line extrapolated
         drop = 0.0
         for _ in range(DEPARTURE_PASSES):
             D = departure_time(0.75 * resolution, model.mass, drop, toward)
             x_b = min(max(x_end + 0.5 - D / dt, x_min), x_end)
-            drop = max(sd[-1] * float(icpt + slope * x_b) - Fs_dir, 0.0)
+            drop = max(s_k * float(icpt + slope * x_b) - Fs_dir, 0.0)
         held = (k_end - n_fit + 1 + x_b - a + 0.5) * dt
         if held < REST_WINDOW:
             # the break-away reads less than a rest window into the rest: the contact crept within
@@ -110,8 +110,8 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
             # of short "rests" faked a growth (the growth test gave p < 1e-3 on 8 of the 526 testable
             # clean records of tuning, tuning-clean, reporting5 and reporting6; 2 of 383 without
             # these rests)
-            sd.pop()
             continue
+        sd.append(s_k)
         Fb.append(float(icpt + slope * x_b))
         tr.append(held)
         rp.append(abs(float(slope)) * (x_end - x_b + 1.0))
