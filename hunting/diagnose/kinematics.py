@@ -115,9 +115,18 @@ def acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
 
 
 def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.0, *,
-                  half_time: float = 0.001) -> np.ndarray:
+                  half_time: float = 0.001, progress_samples: int = 0) -> np.ndarray:
     """bool (n,): the position stays within one count of ``resolution`` [m] (plus four standard
-    deviations of the sensor ``noise`` [m]) over +-half_time [s] (at least 2 samples)."""
+    deviations of the sensor ``noise`` [m]) over +-half_time [s] (at least 2 samples), and it has
+    not progressed by a count in the same direction both over the last and over the next
+    ``progress_samples`` samples.
+
+    The second condition keeps a slow slide a slide: at one count every few samples the
+    position stays within one count over the short span (reporting7 d0385 slid at 1.5 mm/s with
+    a 4.1 um encoder at 800 Hz, every one of its 989 moving validation samples labelled stuck,
+    and the residual there was zero by construction). A mass at rest dithering between two
+    counts never progresses in one direction on both sides; at a stop the samples after it have
+    no count ahead, before a break-away none behind, so the stick phases keep their edges."""
     h = max(1, int(round(half_time / dt)))
     tol = 1.01 * max(resolution, 0.0) + 4.0 * max(noise, 0.0) + 1e-15
     n = q.size
@@ -127,6 +136,13 @@ def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.
     win = sliding_window_view(q, 2 * h + 1)
     still = np.zeros(n, bool)
     still[h:n - h] = (win.max(axis=1) - win.min(axis=1)) <= tol
+    H = int(progress_samples)
+    if H > h and n > 2 * H:
+        q = np.asarray(q, dtype=float)
+        back, ahead = q[H:n - H] - q[:n - 2 * H], q[2 * H:] - q[H:n - H]
+        step = 0.99 * max(resolution, 0.0) + 4.0 * np.sqrt(2.0) * max(noise, 0.0) + 1e-15
+        progress = (back * ahead > 0) & (np.minimum(np.abs(back), np.abs(ahead)) >= step)
+        still[H:n - H] &= ~progress
     return still
 
 
@@ -176,7 +192,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
         resolution = resolution_of(meas.q)
         if resolution == 0 and noise == 0:
             noise = position_noise(meas.q)
-    slide = ~stuck_samples(meas.q, dt, resolution, noise)
+    slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=w // 2)
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))
