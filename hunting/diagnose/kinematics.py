@@ -192,7 +192,8 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
         resolution = resolution_of(meas.q)
         if resolution == 0 and noise == 0:
             noise = position_noise(meas.q)
-    slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=w // 2)
+    # a slide the friction map's velocity vf sees: a count on each side within its half span
+    slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2)
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))
