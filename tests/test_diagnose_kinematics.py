@@ -25,3 +25,37 @@ def test_delayed_drive_is_the_second_difference_of_the_delayed_staircase(delay):
         assert got[k] == pytest.approx(exact, abs=1e-3)
     # whole samples: the aligned drive shifted
     assert np.allclose(kin.delayed_drive(2 * dt)[10:], kin.drive[8:-2])
+
+
+def _quantized(x, res):
+    return res * np.round(x / res)
+
+
+def test_a_slow_slide_is_not_stuck_and_a_rest_keeps_its_edges():
+    """An exactly known motion: rest, a slide at 0.4 counts per sample (the short span sees one
+    count, as reporting7 d0385's 1.5 mm/s at 4.1 um and 800 Hz did), rest again. Every sample of
+    the slide a count away from its ends slides; the rests stick up to the count that ends or
+    starts the motion."""
+    from hunting.diagnose.kinematics import stuck_samples
+    res, dt, n = 1e-6, 1e-3, 600
+    t = np.arange(n) * dt
+    x = np.clip(t - 0.2, 0.0, 0.2) * 0.4 * res / dt          # slides on [0.2, 0.4] s
+    q = _quantized(x + 0.3 * res, res)
+    old = stuck_samples(q, dt, res)
+    new = stuck_samples(q, dt, res, progress_samples=20)
+    inside = (t > 0.2 + 2.5 * dt) & (t < 0.4 - 2.5 * dt)
+    assert old[inside].mean() > 0.9                          # the short span alone calls it a rest
+    assert not new[inside].any()
+    first = np.flatnonzero(np.diff(q) != 0)
+    assert new[1:first[0] - 1].all() and new[first[-1] + 2:n - 1].all()
+
+
+def test_a_rest_dithering_between_two_counts_stays_stuck():
+    """A mass at rest on a count boundary with sensor noise toggles between two counts: it never
+    progresses one way on both sides, so it stays stuck however long the progress span is."""
+    from hunting.diagnose.kinematics import stuck_samples
+    rng = np.random.default_rng(3)
+    res, dt, n = 1e-6, 1e-3, 2000
+    q = _quantized(0.5 * res + 0.2 * res * rng.normal(size=n), res)
+    assert np.unique(q).size >= 2
+    assert stuck_samples(q, dt, res, progress_samples=25)[1:-1].all()
