@@ -59,3 +59,22 @@ def test_a_rest_dithering_between_two_counts_stays_stuck():
     q = _quantized(0.5 * res + 0.2 * res * rng.normal(size=n), res)
     assert np.unique(q).size >= 2
     assert stuck_samples(q, dt, res, progress_samples=25)[1:-1].all()
+
+
+def test_a_slow_slide_counts_only_where_friction_rises_with_speed():
+    """On the falling branch of a Stribeck dip the same count progress is a stick-slip below the
+    count: the progress test is held back where the model's curve falls with speed."""
+    from hunting.diagnose import NominalModel
+    from hunting.diagnose.kinematics import stuck_samples
+    res, dt, n = 1e-6, 1e-3, 600
+    t = np.arange(n) * dt
+    q = _quantized(np.clip(t - 0.2, 0.0, 0.2) * 0.4 * res / dt + 0.3 * res, res)
+    v = np.gradient(q, dt)
+    inside = (t > 0.2 + 2.5 * dt) & (t < 0.4 - 2.5 * dt)
+    dip = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"law": "stribeck", "Fc": 1.0, "Fs": 1.5,
+                                                                       "vs": 0.002, "beta": 1.0, "b": 0.0}})
+    flat = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"Fc": 1.0, "b": 1.0}})
+    assert flat.steady_slide(v[inside]).all()
+    assert not dip.steady_slide(v[inside]).any()
+    assert stuck_samples(q, dt, res, progress_samples=20, progress_where=dip.steady_slide(v))[inside].mean() > 0.9
+    assert not stuck_samples(q, dt, res, progress_samples=20, progress_where=flat.steady_slide(v))[inside].any()

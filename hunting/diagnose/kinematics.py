@@ -115,11 +115,12 @@ def acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
 
 
 def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.0, *,
-                  half_time: float = 0.001, progress_samples: int = 0) -> np.ndarray:
+                  half_time: float = 0.001, progress_samples: int = 0, progress_where=None) -> np.ndarray:
     """bool (n,): the position stays within one count of ``resolution`` [m] (plus four standard
     deviations of the sensor ``noise`` [m]) over +-half_time [s] (at least 2 samples), and it has
     not progressed by a count in the same direction both over the last and over the next
-    ``progress_samples`` samples.
+    ``progress_samples`` samples (where ``progress_where``, bool (n,), allows; default
+    everywhere).
 
     The second condition keeps a slow slide a slide: at one count every few samples the
     position stays within one count over the short span (reporting7 d0385 slid at 1.5 mm/s with
@@ -142,6 +143,8 @@ def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.
         back, ahead = q[H:n - H] - q[:n - 2 * H], q[2 * H:] - q[H:n - H]
         step = 0.99 * max(resolution, 0.0) + 4.0 * np.sqrt(2.0) * max(noise, 0.0) + 1e-15
         progress = (back * ahead > 0) & (np.minimum(np.abs(back), np.abs(ahead)) >= step)
+        if progress_where is not None:
+            progress &= np.asarray(progress_where, bool)[H:n - H]
         still[H:n - H] &= ~progress
     return still
 
@@ -168,11 +171,14 @@ def dilate(mask: np.ndarray, half: int) -> np.ndarray:
 
 
 def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_min_frac: float = 0.02,
-               resolution: float | None = None, noise: float = 0.0) -> Kinematics:
+               resolution: float | None = None, noise: float = 0.0, steady=None) -> Kinematics:
     """Smoothed derivatives of a measurement and the sliding samples (module docstring). window
     [s] defaults to 31 samples (31 ms at 1 kHz); resolution [m] (default: read from the data)
     and noise [m] of the position sensor decide which samples stick (noise 0 with positions that
-    are not quantized and no resolution given: read from the data, :func:`position_noise`)."""
+    are not quantized and no resolution given: read from the data, :func:`position_noise`);
+    steady : optional callable, velocities (n,) [m/s] -> bool (n,), where a slow slide is steady
+    (:meth:`NominalModel.steady_slide`): only there does a position that progresses by a count
+    every few samples count as sliding (:func:`stuck_samples`; default everywhere)."""
     dt = meas.dt
     w = 31 if window is None else int(round(window / dt)) | 1
     if w < 5 or w > meas.n // 2:
@@ -193,7 +199,8 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
         if resolution == 0 and noise == 0:
             noise = position_noise(meas.q)
     # a slide the friction map's velocity vf sees: a count on each side within its half span
-    slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2)
+    slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2,
+                           progress_where=None if steady is None else steady(v))
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))

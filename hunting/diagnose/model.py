@@ -271,6 +271,16 @@ class NominalModel:
         pos, neg = self.curve.positive, self.curve.negative
         return 0.1 * min(pos.vs, neg.vs) if (pos.Fs > pos.Fc or neg.Fs > neg.Fc) else 0.0
 
+    def steady_slide(self, v) -> np.ndarray:
+        """bool (n,): where the static curve's slope d F / d|v| (Stribeck level and viscous term,
+        per direction) is not negative at velocities v (n,) [m/s]: a slow slide there is steady.
+        On the falling branch of a Stribeck dip a slow motion is stick-slip below the encoder's
+        count (tuning d0042 progressed one count per 20 ms at 0.5 mm/s with vs = 4 mm/s while its
+        drive ramped as in a stick)."""
+        v = np.asarray(v, dtype=float)
+        pos, neg = self.curve.positive, self.curve.negative
+        return np.where(v >= 0, pos.level_slope(v) + pos.b, neg.level_slope(v) + neg.b) >= 0
+
     def cogging_force(self, q) -> np.ndarray:
         """F_cog(q) [N]: the sum of the components (0 without cogging)."""
         q = np.asarray(q, dtype=float)
