@@ -78,3 +78,22 @@ def test_a_slow_slide_counts_only_where_friction_rises_with_speed():
     assert not dip.steady_slide(v[inside]).any()
     assert stuck_samples(q, dt, res, progress_samples=20, progress_where=dip.steady_slide(v))[inside].mean() > 0.9
     assert not stuck_samples(q, dt, res, progress_samples=20, progress_where=flat.steady_slide(v))[inside].any()
+
+
+def test_a_pause_between_counts_is_a_stick():
+    """A slide that pauses for 5 samples on one count (a brief stick between two motions) has
+    counts behind and ahead within the progress span, but its short-window velocity near zero
+    says stick (reporting7 d0109: the map's sign at that velocity put 3 N into a clean residual)."""
+    from scipy.signal import savgol_filter
+    from hunting.diagnose.kinematics import stuck_samples
+    res, dt, n = 1e-6, 1e-3, 400
+    t = np.arange(n) * dt
+    x = np.where(t < 0.2, t, 0.2 + np.clip(t - 0.205, 0.0, None)) * 0.4 * res / dt
+    q = _quantized(x + 0.3 * res, res)
+    vf = savgol_filter(q, 11, 3, deriv=1, delta=dt)
+    pause = (t > 0.2005) & (t < 0.2025)                  # counts within 5 samples both ways
+    assert pause.sum() >= 2
+    assert stuck_samples(q, dt, res, progress_samples=5, progress_velocity=vf)[pause].all()
+    assert not stuck_samples(q, dt, res, progress_samples=5)[pause].any()
+    moving = (t > 0.1) & (t < 0.18)
+    assert not stuck_samples(q, dt, res, progress_samples=5, progress_velocity=vf)[moving].any()

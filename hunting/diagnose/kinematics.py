@@ -115,12 +115,14 @@ def acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
 
 
 def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.0, *,
-                  half_time: float = 0.001, progress_samples: int = 0, progress_where=None) -> np.ndarray:
+                  half_time: float = 0.001, progress_samples: int = 0, progress_where=None,
+                  progress_velocity=None) -> np.ndarray:
     """bool (n,): the position stays within one count of ``resolution`` [m] (plus four standard
     deviations of the sensor ``noise`` [m]) over +-half_time [s] (at least 2 samples), and it has
     not progressed by a count in the same direction both over the last and over the next
     ``progress_samples`` samples (where ``progress_where``, bool (n,), allows; default
-    everywhere).
+    everywhere), at a velocity ``progress_velocity`` (n,) [m/s] (when given) of that direction
+    and at least half a count per progress span.
 
     The second condition keeps a slow slide a slide: at one count every few samples the
     position stays within one count over the short span (reporting7 d0385 slid at 1.5 mm/s with
@@ -145,6 +147,11 @@ def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.
         progress = (back * ahead > 0) & (np.minimum(np.abs(back), np.abs(ahead)) >= step)
         if progress_where is not None:
             progress &= np.asarray(progress_where, bool)[H:n - H]
+        if progress_velocity is not None:
+            # a pause of a few ms between counts is a stick, which a short-window velocity near
+            # zero (or of the other sign) tells (reporting7 d0109: 8 ms at one count amid 1 mm/s)
+            vel = np.asarray(progress_velocity, float)[H:n - H]
+            progress &= (vel * back > 0) & (np.abs(vel) * H * dt >= 0.5 * step)
         still[H:n - H] &= ~progress
     return still
 
@@ -200,7 +207,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
             noise = position_noise(meas.q)
     # a slide the friction map's velocity vf sees: a count on each side within its half span
     slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2,
-                           progress_where=None if steady is None else steady(v))
+                           progress_where=None if steady is None else steady(v), progress_velocity=vf)
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))
