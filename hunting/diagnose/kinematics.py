@@ -13,7 +13,8 @@ the model's forces share one bandwidth (parallel filtering, as in inverse-dynami
 identification).
 
 Where the mass sticks (``slide`` false: the position stays within the sensor's resolution over
-a few milliseconds) friction carries whatever force is applied, up to the stick set: there the
+a few milliseconds, and it is not a slow slide that progresses a count every few samples,
+:func:`stuck_samples`) friction carries whatever force is applied, up to the stick set: there the
 residual's integrand is the excess of that force over the model's stick set (zero when the stick
 holds), and a cause that changes a sliding force (an offset, a viscous term, cogging) changes
 nothing: its regressor is H_a[slide * x] (:meth:`Kinematics.sliding`). Without this, the
