@@ -150,7 +150,7 @@ def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.
             progress &= np.asarray(progress_where, bool)[H:n - H]
         if progress_velocity is not None:
             # a pause of a few ms between counts is a stick, which a short-window velocity near
-            # zero (or of the other sign) tells (reporting7 d0109: 8 ms at one count amid 1 mm/s)
+            # zero (or of the other sign) tells (reporting7 d0109: 10 ms at one count amid 1-2 mm/s)
             vel = np.asarray(progress_velocity, float)[H:n - H]
             progress &= (vel * back > 0) & (np.abs(vel) * H * dt >= 0.5 * step)
         still[H:n - H] &= ~progress
