@@ -207,8 +207,13 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
         if resolution == 0 and noise == 0:
             noise = position_noise(meas.q)
     # a slide the friction map's velocity vf sees: a count on each side within its half span
-    slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2,
-                           progress_where=None if steady is None else steady(v), progress_velocity=vf)
+    # (a creep slower than the moving samples' bound stays a stick: presliding's, or a LuGre
+    # contact's break-away, whose bristles the stick channel reads from it)
+    where = np.abs(v) > v_min_frac * np.max(np.abs(v))
+    if steady is not None:
+        where &= steady(v)
+    slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2, progress_where=where,
+                           progress_velocity=vf)
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))
