@@ -97,3 +97,21 @@ def test_a_pause_between_counts_is_a_stick():
     assert not stuck_samples(q, dt, res, progress_samples=5)[pause].any()
     moving = (t > 0.1) & (t < 0.18)
     assert not stuck_samples(q, dt, res, progress_samples=5, progress_velocity=vf)[moving].any()
+
+
+def test_creep_below_the_moving_bound_stays_a_stick():
+    """The same count progress (0.4 counts per sample) is a slide in a record whose fastest
+    motion is 10 times faster, and a stick (presliding's creep, left to the stick channel) where
+    the record also moves 100 times faster: only speeds above 2 % of the largest are slides."""
+    res, dt, n = 1e-6, 1e-3, 1200
+    t = np.arange(n) * dt
+    slow = 0.4 * res / dt
+
+    def record(fast):
+        v = np.where(t < 0.3, fast * np.sin(np.pi * t / 0.3) ** 2, np.where((t > 0.6) & (t < 0.9), slow, 0.0))
+        q = _quantized(np.cumsum(v) * dt + 0.3 * res, res)
+        return kinematics(Measurement(t, q, np.zeros(n)), 1.0, window=0.031, resolution=res)
+
+    creep = (t > 0.65) & (t < 0.85)
+    assert record(10 * slow).slide[creep].all()
+    assert not record(100 * slow).slide[creep].any()
