@@ -65,7 +65,8 @@ def method_error(meas: Measurement, kin: Kinematics, model) -> MethodError | Non
     if not sim.ok:
         return None
     own = Measurement(meas.t, sim.q, sim.u, meas.q_ref, meas.f_ext, name=meas.name + " (nominal loop, noise-free)")
-    ks = kinematics(own, model.cm, window=kin.window, resolution=kin.resolution, noise=kin.noise)
+    ks = kinematics(own, model.cm, window=kin.window, resolution=kin.resolution, noise=kin.noise,
+                    steady=model.steady_slide)
     valid = kin.moving & used_samples(ks, model) & (np.abs(ks.v - kin.v) <= TRACK * np.abs(kin.v))
     if valid.sum() < 100:
         return None

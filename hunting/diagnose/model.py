@@ -157,8 +157,8 @@ class NominalModel:
     equation m q'' = cm u + f_ext - F(q') - offset); sigma0, sigma1 : LuGre parameters when the
     law is lugre; controller : the controller description (dict), or None; source : the dict.
     cogging : tuple of :class:`hunting.models.plant.Cogging` components (harmonic or table),
-    summed; flexibility : a :class:`Flexibility` (load on a spring behind the measured side; the
-    force residual has it, the re-simulation does not); lag [s] : frictional memory of static
+    summed; flexibility : a :class:`Flexibility` (load on a spring behind the measured side, its
+    mass part of ``mass``; residual and re-simulation); lag [s] : frictional memory of static
     laws (the Stribeck level follows g(|v|) through a first-order lag, relaxing to Fs at rest;
     residual and re-simulation, both exactly); dwell : a :class:`Dwell` (break-away force growing with the time at rest;
     re-simulation); delay [s] : actuation delay (the plant
@@ -190,6 +190,9 @@ class NominalModel:
         if self.dwell is not None and not isinstance(self.dwell, Dwell):
             raise SystemDefinitionError(f"dwell = {self.dwell!r} must be a Dwell")
         check_finite_positive("mass", self.mass)
+        if self.flexibility is not None and not self.flexibility.load_mass < self.mass:
+            raise SystemDefinitionError(f"flexibility load_mass = {self.flexibility.load_mass!r} kg must be below the "
+                                        f"mass {self.mass!r} kg: the mass is the total, motor side and load")
         check_finite_positive("motor_constant", self.cm)
         check_finite("offset", self.offset)
         check_finite_positive("delay", self.delay, allow_zero=True)
@@ -267,6 +270,16 @@ class NominalModel:
         of the smaller Stribeck velocity (0 for curves without a Stribeck dip)."""
         pos, neg = self.curve.positive, self.curve.negative
         return 0.1 * min(pos.vs, neg.vs) if (pos.Fs > pos.Fc or neg.Fs > neg.Fc) else 0.0
+
+    def steady_slide(self, v) -> np.ndarray:
+        """bool (n,): where the static curve's slope d F / d|v| (Stribeck level and viscous term,
+        per direction) is not negative at velocities v (n,) [m/s]: a slow slide there is steady.
+        On the falling branch of a Stribeck dip a slow motion is stick-slip below the encoder's
+        count (tuning d0042 progressed one count per 20 ms at 0.5 mm/s with vs = 4 mm/s while its
+        drive ramped as in a stick)."""
+        v = np.asarray(v, dtype=float)
+        pos, neg = self.curve.positive, self.curve.negative
+        return np.where(v >= 0, pos.level_slope(v) + pos.b, neg.level_slope(v) + neg.b) >= 0
 
     def cogging_force(self, q) -> np.ndarray:
         """F_cog(q) [N]: the sum of the components (0 without cogging)."""

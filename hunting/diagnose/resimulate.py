@@ -168,32 +168,66 @@ def _cog(q, cog, bases):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _rates(q, v, z, s, fa, p, cog, bases, steady):
-    """(q', v', z') at applied force fa (cm u + f_ext - offset), direction s for the curve. z is
-    LuGre's bristle deflection, or for a static law with frictional memory (lag p[16] > 0) the
-    lagging Stribeck level: z' = (g(|v|) - z) / lag, F = s z + b v. steady: LuGre's bristles at
-    their steady deflection (z' = 0, F = s g(|v|) + b v: the static curve while sliding)."""
-    base = 4 if s > 0 else 9
-    fd = fa - _cog(q, cog, bases)
-    if p[3] > 0.5 and not steady:
-        zd, F = lugre_rates(v, z, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4], p[14], p[15], 0.0)
-        return v, (fd - F) / p[0], zd
-    g = stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3])
-    if p[16] > 0.0:
-        return v, (fd - s * z - p[base + 4] * v) / p[0], (g - z) / p[16]
-    return v, (fd - s * g - p[base + 4] * v) / p[0], 0.0
+def _load_force(d, w, p):
+    """The flexible load's force on the motor side [N]: its spring p[21] and damper p[22] at the
+    load's position d and velocity w relative to the motor."""
+    return p[21] * d + p[22] * w
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _rk4(q, v, z, s, fa, h, p, cog, bases, steady):
+def _load_rate(d, w, a, p):
+    """w' of the flexible load relative to the motor at motor acceleration a (0 without a load)."""
+    return -_load_force(d, w, p) / p[20] - a if p[20] > 0.0 else 0.0
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _rates(q, v, z, d, w, s, fa, p, cog, bases, steady):
+    """(q', v', z', d', w') at applied force fa (cm u + f_ext - offset), direction s for the
+    curve. z is LuGre's bristle deflection, or for a static law with frictional memory (lag p[16]
+    > 0) the lagging Stribeck level: z' = (g(|v|) - z) / lag, F = s z + b v. steady: LuGre's
+    bristles at their steady deflection (z' = 0, F = s g(|v|) + b v: the static curve while
+    sliding). d, w: the flexible load's position and velocity relative to the motor (load mass
+    p[20], 0 without one: the motor side then carries the whole mass p[0])."""
+    base = 4 if s > 0 else 9
+    fd = fa - _cog(q, cog, bases) + _load_force(d, w, p)
+    m1 = p[0] - p[20]
+    if p[3] > 0.5 and not steady:
+        zd, F = lugre_rates(v, z, s, p[base], p[base + 1], p[base + 2], p[base + 3], p[base + 4], p[14], p[15], 0.0)
+        a = (fd - F) / m1
+        return v, a, zd, w, _load_rate(d, w, a, p)
+    g = stribeck_level(s * v, p[base], p[base + 1], p[base + 2], p[base + 3])
+    if p[16] > 0.0:
+        a = (fd - s * z - p[base + 4] * v) / m1
+        return v, a, (g - z) / p[16], w, _load_rate(d, w, a, p)
+    a = (fd - s * g - p[base + 4] * v) / m1
+    return v, a, 0.0, w, _load_rate(d, w, a, p)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _rk4(q, v, z, d, w, s, fa, h, p, cog, bases, steady):
     """One classical RK4 step of length h with the friction direction s held (steady: as in
-    :func:`_rates`)."""
-    a1, b1, c1 = _rates(q, v, z, s, fa, p, cog, bases, steady)
-    a2, b2, c2 = _rates(q + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, s, fa, p, cog, bases, steady)
-    a3, b3, c3 = _rates(q + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, s, fa, p, cog, bases, steady)
-    a4, b4, c4 = _rates(q + h * a3, v + h * b3, z + h * c3, s, fa, p, cog, bases, steady)
+    :func:`_rates`): the new (q, v, z, d, w)."""
+    a1, b1, c1, d1, e1 = _rates(q, v, z, d, w, s, fa, p, cog, bases, steady)
+    a2, b2, c2, d2, e2 = _rates(q + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, d + 0.5 * h * d1,
+                                w + 0.5 * h * e1, s, fa, p, cog, bases, steady)
+    a3, b3, c3, d3, e3 = _rates(q + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, d + 0.5 * h * d2,
+                                w + 0.5 * h * e2, s, fa, p, cog, bases, steady)
+    a4, b4, c4, d4, e4 = _rates(q + h * a3, v + h * b3, z + h * c3, d + h * d3, w + h * e3, s, fa, p, cog, bases,
+                                steady)
     return (q + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4), v + h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4),
-            z + h / 6.0 * (c1 + 2 * c2 + 2 * c3 + c4))
+            z + h / 6.0 * (c1 + 2 * c2 + 2 * c3 + c4), d + h / 6.0 * (d1 + 2 * d2 + 2 * d3 + d4),
+            w + h / 6.0 * (e1 + 2 * e2 + 2 * e3 + e4))
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _rk4_load(d, w, h, p):
+    """One RK4 step of length h of the flexible load while the motor sticks (its acceleration 0):
+    the new (d, w)."""
+    d1, e1 = w, _load_rate(d, w, 0.0, p)
+    d2, e2 = w + 0.5 * h * e1, _load_rate(d + 0.5 * h * d1, w + 0.5 * h * e1, 0.0, p)
+    d3, e3 = w + 0.5 * h * e2, _load_rate(d + 0.5 * h * d2, w + 0.5 * h * e2, 0.0, p)
+    d4, e4 = w + h * e3, _load_rate(d + h * d3, w + h * e3, 0.0, p)
+    return d + h / 6.0 * (d1 + 2 * d2 + 2 * d3 + d4), w + h / 6.0 * (e1 + 2 * e2 + 2 * e3 + e4)
 
 
 STIFF_RK4 = 1.0   # h sigma0 |v| / g above which a LuGre substep takes the bristles at steady state (RK4: stable below 2.8)
@@ -208,22 +242,22 @@ def _bristle_relaxation(v, s, p):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _rk4_steady_bristles(q, v, s, fa, h, p, cog, bases):
+def _rk4_steady_bristles(q, v, d, w, s, fa, h, p, cog, bases):
     """One RK4 step of length h of a LuGre loop whose bristles relax within the step (h sigma0
     |v| / g beyond STIFF_RK4): they are taken at their steady deflection z = s g(|v|) / sigma0,
     where dz/dt = 0 and the friction is the steady curve (the singular-perturbation limit; its
     error is the bristles' lag, a fraction 1 / (h sigma0 |v| / g) of the step). Plain RK4 on the
-    bristle state needs h sigma0 |v| / g < 2.8 to stay stable. Returns (q, v, z)."""
-    qn, vn, _ = _rk4(q, v, 0.0, s, fa, h, p, cog, bases, True)
+    bristle state needs h sigma0 |v| / g < 2.8 to stay stable. Returns (q, v, z, d, w)."""
+    qn, vn, _, dn, wn = _rk4(q, v, 0.0, d, w, s, fa, h, p, cog, bases, True)
     base = 4 if s > 0 else 9
-    return qn, vn, s * stribeck_level(s * vn, p[base], p[base + 1], p[base + 2], p[base + 3]) / p[14]
+    return qn, vn, s * stribeck_level(s * vn, p[base], p[base + 1], p[base + 2], p[base + 3]) / p[14], dn, wn
 
 
 @numba.njit(cache=True, error_model="numpy", nogil=True)
 def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
           v_out, stuck_out):
-    """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev, rest time]
-    (updated in place). Returns the number of samples done (< r.size when the state stopped being
+    """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev, rest time,
+    d, w] (updated in place; d, w the flexible load's position and velocity relative to the motor). Returns the number of samples done (< r.size when the state stopped being
     finite). The break-away force after a rest of t_r is Fs + dwell level + gain (1 - exp(-t_r /
     time)) (p[17:20]); the controller output is quantized to ctrl[9] when that is > 0."""
     h = dt / substeps
@@ -233,6 +267,7 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
     uc = 0.0
     q, v, z, stuck = x[0], x[1], x[2], x[3] > 0.5
     t_rest = x[9]
+    d, w = x[10], x[11]
     for k in range(r.size):
         qm = q + noise[k]
         y = resolution * math.floor(qm / resolution + 0.5) if resolution > 0.0 else qm
@@ -250,17 +285,19 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
             if lugre:
                 s = 1.0 if v >= 0.0 else -1.0
                 if h * _bristle_relaxation(v, s, p) <= STIFF_RK4:
-                    q, v, z = _rk4(q, v, z, s, fa, h, p, cog, bases, False)
+                    q, v, z, d, w = _rk4(q, v, z, d, w, s, fa, h, p, cog, bases, False)
                 else:
-                    q, v, z = _rk4_steady_bristles(q, v, s, fa, h, p, cog, bases)
+                    q, v, z, d, w = _rk4_steady_bristles(q, v, d, w, s, fa, h, p, cog, bases)
                 continue
             rem = h
             for _ in range(3):             # a substep holds at most a stop and a restart
                 if stuck:
-                    need = fa - _cog(q, cog, bases)
+                    need = fa - _cog(q, cog, bases) + _load_force(d, w, p)
                     grow = p[17] + (p[18] * (1.0 - math.exp(-t_rest / p[19])) if p[19] > 0.0 else 0.0)
                     if -(p[10] + grow) <= need <= p[5] + grow:
                         t_rest += rem
+                        if p[20] > 0.0:    # the load swings on while the motor sticks
+                            d, w = _rk4_load(d, w, rem, p)
                         if p[16] > 0.0:    # the lagging level relaxes to Fs at rest
                             fs = p[5] if need >= 0.0 else p[10]
                             z = fs + (z - fs) * math.exp(-rem / p[16])
@@ -269,32 +306,33 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                     s = 1.0 if need > 0.0 else -1.0
                 else:
                     s = 1.0 if v > 0.0 else -1.0
-                qn, vn, zn = _rk4(q, v, z, s, fa, rem, p, cog, bases, False)
+                qn, vn, zn, dn, wn = _rk4(q, v, z, d, w, s, fa, rem, p, cog, bases, False)
                 if s * vn > 0.0:
-                    q, v, z = qn, vn, zn
+                    q, v, z, d, w = qn, vn, zn, dn, wn
                     break
                 # the velocity reaches zero inside: stop there (located by Newton on the RK4
                 # step's length from the linear estimate, so the stop is as accurate as the
                 # steps), then decide stick or slip for the rest of the substep
                 th = s * v / (s * v - s * vn) if s * v - s * vn > 0.0 else 1.0
                 for it in range(5):
-                    qa, va, za = _rk4(q, v, z, s, fa, th * rem, p, cog, bases, False)
-                    acc = _rates(qa, va, za, s, fa, p, cog, bases, False)[1]
+                    qa, va, za, da, wa = _rk4(q, v, z, d, w, s, fa, th * rem, p, cog, bases, False)
+                    acc = _rates(qa, va, za, da, wa, s, fa, p, cog, bases, False)[1]
                     th_new = th - va / (rem * acc) if acc != 0.0 else th
                     if it == 4 or not 0.0 < th_new <= 1.0 or abs(th_new - th) <= 1e-13:
-                        break              # (qa, za) is the state at th
+                        break              # (qa, za, da, wa) is the state at th
                     th = th_new
-                q, z = qa, za
+                q, z, d, w = qa, za, da, wa
                 v = 0.0
                 stuck = True
                 t_rest = 0.0
                 rem *= 1.0 - th
                 if rem <= 0.0:
                     break
-        if not (math.isfinite(q) and math.isfinite(v) and math.isfinite(z)):
+        if not (math.isfinite(q) and math.isfinite(v) and math.isfinite(z) and math.isfinite(d) and math.isfinite(w)):
             return k
     x[0], x[1], x[2], x[3] = q, v, z, 1.0 if stuck else 0.0
     x[9] = t_rest
+    x[10], x[11] = d, w
     return r.size
 
 
@@ -303,9 +341,14 @@ def model_arrays(model: NominalModel):
     (concatenated; component i starts at bases[i]) of a NominalModel, as the kernel reads them."""
     law = 1.0 if model.law == "lugre" else 0.0
     dw = model.dwell
+    fl = model.flexibility
+    load = (0.0, 0.0, 0.0)
+    if fl is not None and fl.load_mass > 0:
+        wn = 2 * np.pi * fl.frequency
+        load = (fl.load_mass, fl.load_mass * wn ** 2, 2 * fl.damping * wn * fl.load_mass)
     p = np.array([model.mass, model.cm, model.offset, law, *model.curve.positive.encoded(),
                   *model.curve.negative.encoded(), model.sigma0 or 0.0, model.sigma1 or 0.0, model.lag,
-                  *((dw.level, dw.gain, dw.time) if dw is not None else (0.0, 0.0, 0.0))])
+                  *((dw.level, dw.gain, dw.time) if dw is not None else (0.0, 0.0, 0.0)), *load])
     blocks = [c.encoded() for c in model.cogging] or [np.zeros(3)]
     bases = np.cumsum([0] + [b.size for b in blocks[:-1]]).astype(np.int64)
     if not model.cogging:
@@ -407,7 +450,7 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
         z0 = c0.Fs if at_rest else float(c0.level(np.array([abs(v0)]))[0])
     # a record that starts at rest has rested long before it (the dwell effect fully grown)
     x = np.array([q0, 0.0 if at_rest else v0, z0, 1.0 if (at_rest and model.law != "lugre") else 0.0,
-                  I0, 0.0, sig0, q0, q0, 1e9])
+                  I0, 0.0, sig0, q0, q0, 1e9, 0.0, 0.0])
     if x0 is not None:
         x0 = np.asarray(x0, float)
         if x0.shape != (3,) or not np.all(np.isfinite(x0)):

@@ -201,7 +201,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         notes.insert(0, beyond)
     if window is None:
         window = default_window(fit, validate, model)
-    sensor = dict(resolution=model.resolution, noise=model.sensor_noise)
+    sensor = dict(resolution=model.resolution, noise=model.sensor_noise, steady=model.steady_slide)
     kf = kinematics(fit, model.cm, window=window, **sensor)
     kv = kinematics(validate, model.cm, window=window, **sensor)
     check_units(kf, model, fit.name)

@@ -114,7 +114,12 @@ def design(kin, model, hyper):
 
 
 def unphysical(theta, hyper, model) -> str | None:
-    return f"load mass {theta[0]:.3g} kg <= 0" if theta[0] <= 0 else None
+    if theta[0] <= 0:
+        return f"load mass {theta[0]:.3g} kg <= 0"
+    if theta[0] >= model.mass:
+        # the model's mass is the whole, motor side and load (tuning d0235: 81 kg behind 23.8 kg)
+        return f"load mass {theta[0]:.3g} kg >= the whole moving mass {model.mass:.3g} kg"
+    return None
 
 
 def parameters(theta, hyper, model) -> dict:
@@ -125,7 +130,7 @@ def parameters(theta, hyper, model) -> dict:
 
 
 def extend(model, theta, hyper):
-    # the force residual carries the load; the re-simulation engine models the rigid body only
+    # the force residual and the re-simulation both carry the load (two states behind the motor)
     return model.replace(flexibility=Flexibility(max(float(theta[0]), 0.0), hyper["frequency"], hyper["damping"]))
 
 
