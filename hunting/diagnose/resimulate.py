@@ -6,6 +6,10 @@ encoder resolution of the data and the controller's saturation:
 
     m q'' = cm u(t - delay) + f_ext - F - offset - F_cog(q)
 
+with a flexible load (``plant.flexibility``) of mass m2 behind the motor on a spring k and damper c:
+the motor side's mass is m - m2 and it feels k d + c d' besides, d the load's position relative to
+the motor, m2 (q + d)'' = -(k d + c d'); the load swings on while the motor sticks.
+
 Friction F: for the static laws (coulomb-viscous, stribeck, switch) the exact stick of the Switch
 model in its Filippov limit (the mass sticks when its velocity reaches zero and the force it
 needs, |cm u + f_ext - offset - F_cog| <= Fs of that direction, is available; it slips again when
@@ -257,8 +261,8 @@ def _rk4_steady_bristles(q, v, d, w, s, fa, h, p, cog, bases):
 def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, substeps, delay_sub, x, q_out, u_out,
           v_out, stuck_out):
     """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev, rest time,
-    d, w] (updated in place; d, w the flexible load's position and velocity relative to the motor). Returns the number of samples done (< r.size when the state stopped being
-    finite). The break-away force after a rest of t_r is Fs + dwell level + gain (1 - exp(-t_r /
+    d, w] (updated in place; d, w the flexible load's position and velocity relative to the
+    motor). Returns the number of samples done (< r.size when the state stopped being finite). The break-away force after a rest of t_r is Fs + dwell level + gain (1 - exp(-t_r /
     time)) (p[17:20]); the controller output is quantized to ctrl[9] when that is > 0."""
     h = dt / substeps
     lugre = p[3] > 0.5
