@@ -209,15 +209,14 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     # a slide the friction map's velocity vf sees: a count on each side within its half span
     # (a creep slower than the moving samples' bound stays a stick: presliding's, or a LuGre
     # contact's break-away, whose bristles the stick channel reads from it)
-    where = np.abs(v) > v_min_frac * np.max(np.abs(v))
-    if steady is not None:
-        where &= steady(v)
+    fast = np.abs(v) > v_min_frac * np.max(np.abs(v))
+    where = fast if steady is None else fast & steady(v)
     slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2, progress_where=where,
                            progress_velocity=vf)
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))
-    moving = np.abs(v) > v_min_frac * np.max(np.abs(v))
+    moving = fast.copy()
     edge = np.zeros(meas.n, bool)
     edge[w:-w] = True                    # drop the filter's edge samples
     # a stop or a break-away inside the window: the stick classification and the friction map at
