@@ -346,3 +346,16 @@ def test_a_load_heavier_than_the_whole_mass_is_refused():
         NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0,
                                           "flexibility": {"load_mass": 1.0, "frequency": 10.0, "damping": 0.1}},
                                 "friction": {"Fc": 0.1}})
+
+
+def test_a_fitted_load_at_least_the_whole_mass_is_not_physical():
+    """The flexibility cause vetoes such a fit before an extended model is built from it (tuning
+    d0235 fitted 81 kg behind 23.8 kg, and the model then refused it with a traceback)."""
+    from hunting.diagnose.causes import flexibility
+    m = NominalModel.from_dict({"plant": {"mass": 23.8, "motor_constant": 1.0}, "friction": {"Fc": 1.0}})
+    hyper = {"frequency": 30.0, "damping": 0.1}
+    assert "whole moving mass" in flexibility.unphysical([81.0], hyper, m)
+    assert "whole moving mass" in flexibility.unphysical([23.8], hyper, m)
+    assert "<= 0" in flexibility.unphysical([-1.0], hyper, m)
+    assert flexibility.unphysical([5.0], hyper, m) is None
+    assert flexibility.extend(m, [5.0], hyper).flexibility.load_mass == 5.0
