@@ -398,6 +398,13 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
         # other): its residual is no picture of the noise; those members are left out
         full = lib.best_variants(tuple(n for n in full.names if n not in full.unphysical))
         e_full = (lib.rv - lib.prediction(full, "v"))[Sv.idx]
+    if _rms(e_full) > _rms(lib.rv[Sv.idx]):
+        # physical members whose signatures are collinear on the fitting data and separate on the
+        # validation data (a fitting record that moves one way only: offset, level and Stribeck
+        # alike) predict it worse than nothing, and a noise model of that residual makes every
+        # test insignificant: the searched set that predicts the validation data best is the
+        # picture of the noise instead
+        e_full = min(((lib.rv - lib.prediction(e, "v"))[Sv.idx] for e in fits.values() if e.physical), key=_rms)
     noise_v = NoiseModel.fit(e_full, Sv.run)
     current = ranking[0]
     floor = PRECISION * _rms(lib.kv.force[lib.used_v])
