@@ -299,3 +299,16 @@ def test_lugre_nominal_with_a_dip_gives_no_mass():
     assert truth["causes"] == [] and model.law == "lugre"
     d = diagnose(fit, model, val, behaviour=False)
     assert d.causes == [], [(c.name, c.parameters) for c in d.causes]
+
+
+def test_offset_on_a_one_way_fitting_record_is_found():
+    """reporting8 d0314: an offset of -1.37 N (97 % of the validation residual) on a fitting
+    record that moves one way only. There offset, level and Stribeck are one signature; the whole
+    library fitted on it predicted the two-way validation record worse than nothing, and a noise
+    model of that residual made every test insignificant (offset p = 1). The searched set that
+    predicts the validation data best is the noise picture instead, and the offset is found."""
+    fit, val, model, truth = _dataset("reporting8", 314)
+    assert truth["causes"] == ["offset"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["offset"]
+    assert d.causes[0].parameters["offset"] == pytest.approx(truth["effects"][0]["params"]["offset"], rel=0.02)

@@ -105,6 +105,23 @@ def test_out_of_sample_with_no_residual_left_is_no_test():
     assert gamma == pytest.approx(1.0) and p == 1.0
 
 
+
+
+def test_out_of_sample_with_an_alternating_residual_keeps_a_variance():
+    """An over-differenced residual (lag-1 autocorrelation -1/2) beside a smooth prediction makes
+    the truncated sum of autocovariances non-positive; it read as no variance and p = 1 for a
+    prediction that explains all of the residual (blind reporting8 d0530: a level change of 98 %
+    of the validation residual, rejected). The lag-0 term stands in: a finite variance, p ~ 0."""
+    from hunting.diagnose.stats import long_run_meat
+    rng = np.random.default_rng(3)
+    w = rng.normal(0.0, 0.01, 401)
+    noise = w[1:] - w[:-1]
+    yhat = np.full(400, 0.2)
+    run = np.zeros(400, np.int64)
+    S = long_run_meat(yhat[:, None], noise, run)
+    assert S[0, 0] > 0
+    gamma, t, p = out_of_sample(yhat + noise, yhat, run, NoiseModel(np.zeros(0), float(noise.var())))
+    assert gamma == pytest.approx(1.0, abs=0.01) and np.isfinite(t) and p < 1e-6
 def _feedback_draw(rng, theta=2.0):
     """A regressor measured with the noise that also drives the residual (feedback puts the
     sensor's noise into the drive and into the force balance alike): x_meas = x + n, y = theta x
