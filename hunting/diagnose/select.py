@@ -50,7 +50,7 @@ from .model import NominalModel
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
         "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once; each "
         "of its causes kept when it explains the validation residual of the others out of sample (one-sided test, "
-        "prewhitened, autocorrelation-consistent standard error, p < {alpha:g}; with a moving reference its prediction "
+        "prewhitened, autocorrelation-consistent standard error, Student's t with the validation data's filter windows less one as degrees of freedom, p < {alpha:g}; with a moving reference its prediction "
         "along the reference too, p < {alpha_reference:g}), dropping it grows the validation RMS by at least "
         "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much, and the general one to the special case otherwise); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%}")

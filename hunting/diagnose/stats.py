@@ -213,11 +213,14 @@ def wald(theta: np.ndarray, cov: np.ndarray, cols) -> tuple[float, float]:
     return W, float(stats.chi2.sf(W, cols.size))
 
 
-def out_of_sample(e0: np.ndarray, yhat: np.ndarray, run: np.ndarray, noise: NoiseModel) -> tuple[float, float, float]:
+def out_of_sample(e0: np.ndarray, yhat: np.ndarray, run: np.ndarray, noise: NoiseModel,
+                  dof: float | None = None) -> tuple[float, float, float]:
     """(gamma, t, p): regression of the validation residual without a cause, e0 (m,), on the
     cause's predicted contribution yhat (m,) (fitted on other data), both prewhitened by
     ``noise``, with the standard error of :func:`long_run_meat`; p = P(T >= t) under gamma = 0
-    (one-sided: a cause that explains the validation data has gamma near 1)."""
+    (one-sided: a cause that explains the validation data has gamma near 1), T Student's t with
+    ``dof`` degrees of freedom (the residual's independent stretches less one: the variance is
+    estimated from that many) or the normal when dof is None."""
     ew, rw = noise.whiten(e0, run)
     yw, _ = noise.whiten(yhat, run)
     ss = float(yw @ yw)
@@ -231,4 +234,4 @@ def out_of_sample(e0: np.ndarray, yhat: np.ndarray, run: np.ndarray, noise: Nois
         # Seen with a diverging prediction (1.9e24 N) whose fit left no residual on 105 samples
         return gamma, 0.0, 1.0
     t = gamma / np.sqrt(var)
-    return gamma, float(t), float(stats.norm.sf(t))
+    return gamma, float(t), float(stats.norm.sf(t) if dof is None else stats.t.sf(t, max(float(dof), 1.0)))
