@@ -180,6 +180,8 @@ class Library:
                 if np.any(v.sf):
                     shifts.append(v.sf[idx])
         self.n_cols = c
+        # the variants of the search (a refinement appends variants of its own, not indexed here)
+        self.n_indexed = {name: len(vs) for name, vs in self.variants.items()}
         X = np.column_stack(cols) if cols else np.zeros((idx.size, 0))
         S = np.column_stack(shifts) if shifts else np.zeros((idx.size, 0))
         y = self.rf[idx]
@@ -198,6 +200,8 @@ class Library:
         self.m = Zw.shape[0]
         self.G = Zw.T @ Zw
         self.X_thin, self.S_thin, self.y_thin = X, S, y
+        XS = np.column_stack([X, S])
+        self.U_gram = XS.T @ XS
         # the instrumented estimate's moments (:meth:`fit`), unwhitened: Z'X, Z'S, Z'y with each
         # column its own instrument unless its variant has one (Zf)
         Z = np.column_stack(zcols) if zcols else np.zeros((idx.size, 0))
@@ -261,11 +265,20 @@ class Library:
         each other, not effects (a clean record gave a 8.8e8 kg mass, a 2.6e7 s delay and a level
         scaled by 2.7e10 that cancelled to a 2 % residual)."""
         out, k = {}, 0
+        U, m = self.U_gram, max(self.X_thin.shape[0], 1)
         for name, j in members:
             cols, s = self.slot[(name, j)]
-            part = self.X_thin[:, cols] @ theta[k:k + len(cols)] + (self.S_thin[:, s] if s is not None else 0.0)
+            th = theta[k:k + len(cols)]
             k += len(cols)
-            size = _rms(part)
+            if name in known:
+                continue
+            # |X th + S_s|^2 / m from the unwhitened Gram matrix of [X, S] (the part itself is
+            # thousands of samples long, and the search asks this of every set it fits)
+            sq = th @ U[np.ix_(cols, cols)] @ th
+            if s is not None:
+                js = self.n_cols + s
+                sq += 2.0 * th @ U[cols, js] + U[js, js]
+            size = float(np.sqrt(max(sq, 0.0) / m))
             if name not in known and size > CANCEL * self.drive_rms:
                 out[name] = (f"its force change ({size:.3g} N RMS) is {size / max(self.drive_rms, 1e-300):.3g} times the "
                              "drive force's: cancelled by the other causes of the set, not an effect of its own")
@@ -280,9 +293,9 @@ class Library:
         for _ in range(2):
             changed = False
             for n in names:
-                if len(self.variants[n]) == 1:
+                if self.n_indexed[n] == 1:
                     continue
-                fits = [self.fit([(m, (j if m == n else cur[m])) for m in names]) for j in range(len(self.variants[n]))]
+                fits = [self.fit([(m, (j if m == n else cur[m])) for m in names]) for j in range(self.n_indexed[n])]
                 ok = [f.rss if f.physical else np.inf for f in fits]
                 lo = min(ok)
                 if not np.isfinite(lo):
