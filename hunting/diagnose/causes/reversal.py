@@ -103,7 +103,7 @@ def rest_force(kin, model) -> np.ndarray:
     stick, which the bristles pass through integrated (their drive is mostly inertia)."""
     from ..behaviour import stick_phases
     out = np.full(kin.t.size, np.nan)
-    F = kin.drive - model.offset - model.cogging_force(kin.q)
+    F = kin.delayed_drive(model.delay) - model.offset - model.cogging_force(kin.q)
     guard = int(round(REST_GUARD / kin.dt))
     # rests read as dwell's are (two counts, or the sensor's noise band): the samples' own stick
     # label splits a rest wherever noise moves the position by a count (463 pieces of at most
