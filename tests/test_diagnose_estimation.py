@@ -305,8 +305,8 @@ def test_offset_on_a_one_way_fitting_record_is_found():
     """reporting8 d0314: an offset of -1.37 N (97 % of the validation residual) on a fitting
     record that moves one way only. There offset, level and Stribeck are one signature; the whole
     library fitted on it predicted the two-way validation record worse than nothing, and a noise
-    model of that residual made every test insignificant (offset p = 1). The searched set that
-    predicts the validation data best is the noise picture instead, and the offset is found."""
+    model of that residual made every test insignificant (offset p = 1). The nominal validation
+    residual is the noise picture instead, and the offset is found."""
     fit, val, model, truth = _dataset("reporting8", 314)
     assert truth["causes"] == ["offset"]
     d = diagnose(fit, model, val, behaviour=False)
