@@ -352,3 +352,14 @@ def test_reversal_bristles_carry_the_rest_force():
     p, e = d.causes[0].parameters, truth["effects"][0]["params"]
     assert p["sigma0"] == pytest.approx(e["sigma0"], rel=0.03)
     assert p["zeta"] == pytest.approx(e["sigma1"] / (2 * math.sqrt(e["sigma0"] * model.mass)), rel=0.1)
+
+
+def test_instrument_loop_saturates_where_the_data_do():
+    """reporting9 d0568: a frictional memory (lag 0.33 of the force residual) beside a saturation
+    the model lacks. The instrument trajectory re-simulated the nominal loop without it, did not
+    follow the saturated record, and the lag failed its instrument check (p = 0.92). With the
+    measured saturation in the instrument's loop both are found."""
+    fit, val, model, truth = _dataset("reporting9", 568)
+    assert sorted(truth["causes"]) == ["lag", "saturation"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert sorted(c.name for c in d.causes) == ["lag", "saturation"], [(c.name, c.parameters) for c in d.causes]

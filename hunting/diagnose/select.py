@@ -217,9 +217,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     windows = min(k.moving.sum() * k.dt / k.window for k in (kf, kv))
     if force_names and kf.moving.sum() >= 100 and kv.moving.sum() >= 100 and windows >= MIN_WINDOWS:
         step = max(1, int(round(kf.window / fit.dt)) // 3)
-        kr = reference_kinematics(validate, model, window=window)
-        kfr = reference_kinematics(fit, model, window=window) if kr is not None else None
-        inst = ((lambda m: reference_kinematics(validate, m, window=window)) if kr is not None and model.controller is not None
+        sat = measured_saturation(fit, validate, model, alpha)
+        kr = reference_kinematics(validate, sat(model), window=window)
+        kfr = reference_kinematics(fit, sat(model), window=window) if kr is not None else None
+        inst = ((lambda m: reference_kinematics(validate, sat(m), window=window)) if kr is not None and model.controller is not None
                 else None)
         from .method_error import method_error
         errors = (method_error(fit, kf, model), method_error(validate, kv, model))
@@ -295,6 +296,22 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
                      fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
                      fc["explanations"])
+
+
+def measured_saturation(fit: Measurement, validate: Measurement, model: NominalModel, alpha: float):
+    """model -> model: the controller with the saturation the measured output piles up at (the
+    saturation cause's evidence, p < alpha), where the model's controller has none at that level;
+    the identity otherwise. The instrument trajectories re-simulate the loop from the reference:
+    a loop that saturates follows it otherwise only where it does not, and a force-channel cause
+    beside the saturation failed its instrument check (reporting9 d0554 mass, d0568 lag, and
+    reporting8 d0560 viscous, all beside a saturation that the own channel found)."""
+    from .causes import saturation as sat
+    if model.controller is None:
+        return lambda m: m
+    U, top, _, p = sat.evidence(sat.records_output(fit, validate))
+    if not (p < alpha and top >= sat.MIN_AT_BOUND and U > 0 and sat.model_level(model) > 1.01 * U):
+        return lambda m: m
+    return lambda m: m.replace(controller=dict(m.controller, saturation=U)) if m.controller is not None else m
 
 
 def one_way_offset(result: list, untested: list, model: NominalModel, kin: Kinematics) -> list:
