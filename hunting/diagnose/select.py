@@ -303,8 +303,8 @@ def measured_saturation(fit: Measurement, validate: Measurement, model: NominalM
     saturation cause's evidence, p < alpha), where the model's controller has none at that level;
     the identity otherwise. The instrument trajectories re-simulate the loop from the reference:
     a loop that saturates follows it otherwise only where it does not, and a force-channel cause
-    beside the saturation failed its instrument check (reporting9 d0554 mass, d0568 lag, and
-    reporting8 d0560 viscous, all beside a saturation that the own channel found)."""
+    beside the saturation failed its instrument check (reporting9 d0554 mass and d0568 lag, found
+    since; reporting8 d0560's viscous still fails it), beside a saturation the own channel found."""
     from .causes import saturation as sat
     if model.controller is None:
         return lambda m: m
