@@ -278,7 +278,7 @@ class Library:
                 js = self.n_cols + s
                 sq += 2.0 * th @ U[cols, js] + U[js, js]
             size = float(np.sqrt(max(sq, 0.0) / m))
-            if name not in known and size > CANCEL * self.drive_rms:
+            if size > CANCEL * self.drive_rms:
                 out[name] = (f"its force change ({size:.3g} N RMS) is {size / max(self.drive_rms, 1e-300):.3g} times the "
                              "drive force's: cancelled by the other causes of the set, not an effect of its own")
         return out
