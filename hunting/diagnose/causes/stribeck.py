@@ -48,14 +48,8 @@ def design(kin, model, hyper):
     v = kin.vf
     s = np.sign(v)
     beta = np.where(v > 0, exponent(model.curve.positive), exponent(model.curve.negative))
-    vs = np.where(v > 0, hyper["vs"], _vs_neg(hyper))
+    vs = np.where(v > 0, hyper["vs"], hyper["vs_neg"])
     return kin.sliding(np.column_stack([s, s * np.exp(-(np.abs(v) / vs) ** beta)]))
-
-
-def _vs_neg(hyper) -> float:
-    """The negative direction's Stribeck velocity [m/s] (the positive one's for a variant
-    without its own)."""
-    return float(hyper.get("vs_neg", hyper["vs"]))
 
 
 def shift(kin, model, hyper) -> np.ndarray:
@@ -63,7 +57,7 @@ def shift(kin, model, hyper) -> np.ndarray:
     [N] (n,): zero for a curve without a dip."""
     v = kin.vf
     out = np.zeros_like(v)
-    for c, side, vs in ((model.curve.positive, v > 0, hyper["vs"]), (model.curve.negative, v < 0, _vs_neg(hyper))):
+    for c, side, vs in ((model.curve.positive, v > 0, hyper["vs"]), (model.curve.negative, v < 0, hyper["vs_neg"])):
         dip = c.Fs - c.Fc
         if dip:
             a = np.abs(v[side])
@@ -85,7 +79,7 @@ def unphysical(theta, hyper, model) -> str | None:
 def parameters(theta, hyper, model) -> dict:
     c = model.curve.positive
     Fc = float(c.Fc + theta[0])
-    return {"Fc": Fc, "Fs": float(Fc + c.Fs - c.Fc + theta[1]), "vs": hyper["vs"], "vs_neg": _vs_neg(hyper)}
+    return {"Fc": Fc, "Fs": float(Fc + c.Fs - c.Fc + theta[1]), "vs": hyper["vs"], "vs_neg": hyper["vs_neg"]}
 
 
 def extend(model, theta, hyper):
@@ -96,14 +90,14 @@ def extend(model, theta, hyper):
             Fc = max(c.Fc + float(theta[0]), 0.0)
             return replace(c, Fc=Fc, Fs=Fc + (c.Fs - c.Fc) + float(theta[1]), vs=vs, beta=exponent(c))
         return curve
-    out = with_curves(model, new(hyper["vs"]), new(_vs_neg(hyper)))
+    out = with_curves(model, new(hyper["vs"]), new(hyper["vs_neg"]))
     return out.replace(law="stribeck") if model.law == "coulomb-viscous" else out
 
 
 def _velocities(p, model=None) -> str:
     """The Stribeck velocity words: one value, or one per direction where they differ by more
     than 5 %."""
-    vs, vn = p["vs"], p.get("vs_neg", p["vs"])
+    vs, vn = p["vs"], p["vs_neg"]
     own = "" if model is None else f" (model {_q(model.curve.positive.vs, None, 'm/s')})"
     if abs(vn / vs - 1.0) <= 0.05:
         return f"Stribeck velocity vs = {_q(vs, None, 'm/s')}{own}"
