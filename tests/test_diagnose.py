@@ -444,11 +444,15 @@ def test_sentences_quote_no_model_value_the_nominal_law_lacks():
     and 'inf %'; a model without offset 'has 0 N'."""
     from hunting.diagnose.causes import CAUSES
     cv = NominalModel.from_dict(NOMINAL)
-    s = CAUSES["stribeck"].sentence({"Fc": 19.0, "Fs": 30.0, "vs": 0.234}, {}, cv)
+    # the parameters a Stribeck cause reports (parameters() always gives both directions)
+    p = {"Fc": 19.0, "Fs": 30.0, "vs": 0.234, "vs_neg": 0.234}
+    s = CAUSES["stribeck"].sentence(p, {}, cv)
     assert "no Stribeck dip" in s and "1 m/s" not in s and "model 20 N" not in s.split("Fc")[0], s
     assert "234 mm/s" in s
     dipped = true_model(replace(TruePlant(), Fs=30.0, vs=0.01))
-    assert "(model 10 mm/s)" in CAUSES["stribeck"].sentence({"Fc": 19.0, "Fs": 30.0, "vs": 0.234}, {}, dipped)
+    assert "(model 10 mm/s)" in CAUSES["stribeck"].sentence(p, {}, dipped)
+    s = CAUSES["stribeck"].sentence({**p, "vs_neg": 0.1}, {}, dipped)
+    assert "234 mm/s moving positive, 100 mm/s moving negative" in s, s
     coulomb = NominalModel.from_dict({"plant": NOMINAL["plant"], "friction": {"law": "coulomb-viscous", "Fc": 20.0}})
     for name, p in (("viscous", {"b": 200.0}), ("asymmetry", {"b_pos": 190.0, "b_neg": 210.0})):
         s = CAUSES[name].sentence(p, {}, coulomb)
