@@ -92,8 +92,35 @@ def hypers(kin, model) -> list:
             th, *_ = np.linalg.lstsq(A, rb - rb.mean(), rcond=None)
             fits.append((float(np.sum((rb - rb.mean() - A @ th) ** 2)), pitch))
         best = min(s for s, _ in fits)
-        out.append({"pitch": next(p for s, p in fits if s <= best * (1 + 1e-3))})
+        coarse = next(p for s, p in fits if s <= best * (1 + 1e-3))
+        out.append({"pitch": _refined(kin, model, residual(kin, model), coarse)})
     return sorted(out, key=lambda h: h["pitch"])
+
+
+def _refined(kin, model, r, pitch: float) -> float:
+    """The pitch [m] within +-1 % of ``pitch`` whose filtered harmonics (the cause's design) fit
+    the residual r (n,) [N] best on the moving samples: a 0.05 % grid, then the vertex of the
+    parabola through the best point and its neighbours.
+
+    The binned spectrum holds all of the residual, not only what is periodic, and its least
+    squares is flat near the pitch: its best grid point was 0.5 % short on reporting9 d0344
+    (62 periods in the stroke, so the phase drifted by a third of a period and the validation
+    gain fell from 7 % to 5 %), where the filtered design's minimum is sharp at the truth."""
+    m = kin.moving
+    y = r[m]
+    grid = pitch * np.linspace(0.99, 1.01, 41)
+    rss = []
+    for p in grid:
+        X = design(kin, model, {"pitch": float(p)})[m]
+        th, *_ = np.linalg.lstsq(X, y, rcond=None)
+        rss.append(float(np.sum((y - X @ th) ** 2)))
+    i = int(np.argmin(rss))
+    if 0 < i < grid.size - 1:
+        a, b, c = rss[i - 1], rss[i], rss[i + 1]
+        den = a - 2 * b + c
+        if den > 0:
+            return float(grid[i] + 0.5 * (a - c) / den * (grid[1] - grid[0]))
+    return float(grid[i])
 
 
 def _harmonics(q, pitch):
