@@ -388,3 +388,16 @@ def test_a_fitting_record_that_hardly_slides_gives_way_to_the_validation_record(
     assert [c.name for c in d.causes] == ["offset"], [(c.name, c.parameters) for c in d.causes]
     assert d.causes[0].parameters["offset"] == pytest.approx(truth["effects"][0]["params"]["offset"], rel=0.05)
     assert any("first 60 % of the validation data" in n for n in d.notes), d.notes
+
+
+def test_stribeck_velocity_between_grid_points_is_found():
+    """reporting9 d0443: the Stribeck velocity changed from 5.7 to 3.1 mm/s in both directions,
+    below the slowest used speed (9.8 mm/s). The best grid point (9.8 and 4.9 mm/s) left 15 times
+    the residual of the truth on the fitting data, and a level change was named. Moved off the
+    grid by Nelder-Mead before the search, the dip is named alone, vs within 5 %."""
+    fit, val, model, truth = _dataset("reporting9", 443)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
+    p, e = d.causes[0].parameters, truth["effects"][0]["params"]
+    assert p["vs"] == pytest.approx(e["vs"], rel=0.05) and p["vs_neg"] == pytest.approx(e["vs"], rel=0.05)
+    assert p["Fs"] == pytest.approx(e["Fs"], rel=0.02)

@@ -23,6 +23,7 @@ HYPERS = 2
 HYPER_KEYS = ("vs", "vs_neg")
 UNITS = {"Fc": "N", "Fs": "N", "vs": "m/s", "vs_neg": "m/s"}
 RATIOS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0)      # vs_neg / vs searched
+REFINED_ALONE = True      # the best grid point alone is moved off the grid before the search (force.Library)
 NESTS = ("level",)        # a level change is this change at the nominal shape (force.select decides between them)
 
 
