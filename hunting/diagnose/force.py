@@ -66,7 +66,7 @@ PRECISION = 1e-4      # a cause must remove more than this fraction of the drive
 CANCEL = 3.0          # a member's force change beyond this many drive-force RMS is cancelled by the others
 IV_MIN_CORR = 0.5     # a noise-fed regressor is instrumented when its instrument correlates at least this much
 REFINE_EVALUATIONS = 60  # fits a cause with REFINED_ALONE spends moving its best grid variant (Library)
-REFINE_WIDEN = 4.0       # ... within its grid's span widened by this factor each way
+REFINE_WIDEN = 4.0       # ... within its grid's span widened downwards by this factor
 PRECISION_WORDS = 10.0   # reports call a residual "numerical precision" up to this many floors (words only)
 
 
@@ -156,7 +156,7 @@ class Library:
     def _refined_alone(self, name: str) -> dict | None:
         """The hyper-parameters of a cause's best grid variant alone (least squares on the thinned
         fitting residual) moved by Nelder-Mead in log scale (at most REFINE_EVALUATIONS fits,
-        within the grid's span widened by REFINE_WIDEN), or
+        within the grid's span widened downwards by REFINE_WIDEN), or
         None when that fits no better. The search then has the grid and this point: a Stribeck
         velocity's valley can be narrower than the grid's step (reporting9 d0443: vs 3.1 mm/s in
         both directions; the best grid point, 9.8 and 4.9 mm/s, left 15 times the residual and a
@@ -182,11 +182,12 @@ class Library:
             s = shift(self.kf, self.model, h)[idx] if shift else np.zeros(idx.size)
             return rss(mod.design(self.kf, self.model, h)[idx], s)
         x0 = np.log([start[k] for k in keys])
-        # within the grid's span widened by REFINE_WIDEN (far above the measured speeds a Stribeck
-        # velocity is a level change: reporting9 d0415 went to 860 m/s; a dip below them shows by
-        # its tail: d0443's 3.1 mm/s, the slowest used speed 9.8 mm/s)
+        # within the grid's span widened downwards by REFINE_WIDEN: a dip below the measured speeds
+        # shows by its tail (reporting9 d0443's 3.1 mm/s, the slowest used speed 9.8 mm/s), one
+        # above them is a constant per direction (d0415 went to 860 m/s unbounded; d0625's 0.44 m/s
+        # on one side and 2.5 mm/s on the other mimicked a Coulomb asymmetry)
         span = [(np.log(min(v.hyper[k] for v in self.variants[name]) / REFINE_WIDEN),
-                 np.log(max(v.hyper[k] for v in self.variants[name]) * REFINE_WIDEN)) for k in keys]
+                 np.log(max(v.hyper[k] for v in self.variants[name]))) for k in keys]
         out = minimize(cost, x0, method="Nelder-Mead", bounds=span,
                        options=dict(maxfev=REFINE_EVALUATIONS, xatol=0.005, fatol=1e-6 * fits[j]))
         if not (np.all(np.isfinite(out.x)) and out.fun < fits[j] * (1 - 1e-3)):
