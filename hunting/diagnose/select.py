@@ -190,8 +190,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         if fit.n < 250:
             raise SystemDefinitionError(f"{fit.name}: {fit.n} samples are too few to split into fitting and validation "
                                         "parts (need >= 250, or give validation data)")
-        t_split = fit.t[0] + 0.6 * (fit.t[-1] - fit.t[0])
-        fit, validate = fit.part(fit.t[0], t_split), fit.part(t_split, fit.t[-1] + fit.dt)
+        fit, validate = _split(fit)
     notes: list = list(check_inputs(fit, validate, model))
     if same:
         notes.append(SAME_DATA_NOTE.format(validate.name))
@@ -374,6 +373,12 @@ POOR_FIT_NOTE = ("the fitting data ({name}) have {n} sliding samples the force c
                  "judged on the rest; give a fitting record that slides in both directions to use all of them")
 
 
+def _split(record: Measurement) -> tuple[Measurement, Measurement]:
+    """(first 60 %, last 40 %) of a record by time: fitting and validation parts."""
+    t_split = record.t[0] + 0.6 * (record.t[-1] - record.t[0])
+    return record.part(record.t[0], t_split), record.part(t_split, record.t[-1] + record.dt)
+
+
 def _informative(kin, sliding: bool = False) -> bool:
     """Whether a record's used samples (``kin.moving``; with ``sliding``, those of them where the
     mass slides, the only ones a sliding force's design is not zero on) suffice for the force
@@ -386,10 +391,9 @@ def _split_validation(validate: Measurement, model: NominalModel, sensor: dict, 
     """(fit, validate, window, kf, kv): the validation record's first 60 % and last 40 % with
     their kinematics (used samples marked), the smoothing window ``window`` [s] or the parts'
     default; None when either part is not :func:`_informative`."""
-    t_split = validate.t[0] + 0.6 * (validate.t[-1] - validate.t[0])
-    fit, val = validate.part(validate.t[0], t_split), validate.part(t_split, validate.t[-1] + validate.dt)
-    if min(fit.n, val.n) < 125:
+    if validate.n < 250:
         return None
+    fit, val = _split(validate)
     w = default_window(fit, val, model) if window is None else window
     kf, kv = (kinematics(m, model.cm, window=w, **sensor) for m in (fit, val))
     kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
