@@ -128,7 +128,7 @@ def test_cancelling_members_are_not_an_explanation():
 
 def test_cancelling_rule_names_the_member():
     from hunting.diagnose.force import CANCEL, Library
-    fit, val, model, _ = _dataset("tuning", 40)
+    fit, val, model, _ = _dataset("tuning", 41)
     from dataclasses import replace
     kf = kinematics(fit, model.cm, window=31 * fit.dt, resolution=model.resolution, noise=model.sensor_noise)
     kv = kinematics(val, model.cm, window=31 * fit.dt, resolution=model.resolution, noise=model.sensor_noise)
