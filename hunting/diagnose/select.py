@@ -212,10 +212,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
     nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
     kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
-    if force_names and not same and not _informative(kf, True) and _informative(kv, True):
+    if force_names and not same and not _informative(kf) and _informative(kv):
         parts = _split_validation(validate, model, sensor, window if window_given else None)
         if parts is not None:
-            notes.append(POOR_FIT_NOTE.format(name=fit.name, n=int((kf.moving & kf.slide).sum()), val=validate.name))
+            notes.append(POOR_FIT_NOTE.format(name=fit.name, n=int(kf.moving.sum()), val=validate.name))
             fit, validate, window, kf, kv = parts
             nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
     untested: list = []
@@ -379,11 +379,10 @@ def _split(record: Measurement) -> tuple[Measurement, Measurement]:
     return record.part(record.t[0], t_split), record.part(t_split, record.t[-1] + record.dt)
 
 
-def _informative(kin, sliding: bool = False) -> bool:
-    """Whether a record's used samples (``kin.moving``; with ``sliding``, those of them where the
-    mass slides, the only ones a sliding force's design is not zero on) suffice for the force
-    channel: at least 100, spanning at least MIN_WINDOWS filter windows."""
-    n = int((kin.moving & kin.slide).sum() if sliding else kin.moving.sum())
+def _informative(kin) -> bool:
+    """Whether a record's used samples (``kin.moving``, :func:`used_samples`) suffice for the
+    force channel: at least 100, spanning at least MIN_WINDOWS filter windows."""
+    n = int(kin.moving.sum())
     return n >= 100 and n * kin.dt / kin.window >= MIN_WINDOWS
 
 
@@ -397,7 +396,7 @@ def _split_validation(validate: Measurement, model: NominalModel, sensor: dict, 
     w = default_window(fit, val, model) if window is None else window
     kf, kv = (kinematics(m, model.cm, window=w, **sensor) for m in (fit, val))
     kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
-    if not (_informative(kf, True) and _informative(kv, True)):
+    if not (_informative(kf) and _informative(kv)):
         return None
     return fit, val, w, kf, kv
 
