@@ -215,7 +215,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if force_names and not same and not _informative(kf) and _informative(kv):
         parts = _split_validation(validate, model, sensor, window if window_given else None)
         if parts is not None:
-            notes.append(POOR_FIT_NOTE.format(name=fit.name, n=int(kf.moving.sum()), val=validate.name))
+            notes.append(POOR_FIT_NOTE.format(name=fit.name, n=int(kf.moving.sum()), val=validate.name,
+                                              windows=kf.moving.sum() * kf.dt / kf.window))
             fit, validate, window, kf, kv = parts
             nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
     untested: list = []
@@ -368,8 +369,8 @@ WINDOW_CYCLES = 0.5      # the smoothing window, in periods of the loop's bandwi
 # sliding samples in a 7 s fitting record that creeps at 0.3 mm/s, an offset of 79 % of the
 # validation residual went unreported; d0308: all of its fitting record inside the Stribeck dip)
 POOR_FIT_NOTE = ("the fitting data ({name}) have {n} sliding samples the force channel can use (away from stops, "
-                 "the friction map not too steep there; fewer than 100 or spanning fewer than " + str(MIN_WINDOWS) +
-                 " filter windows): the force channel fitted on the first 60 % of the validation data ({val}) and "
+                 "the friction map not too steep there), spanning {windows:.1f} filter windows (it needs 100 spanning "
+                 + str(MIN_WINDOWS) + "): the force channel fitted on the first 60 % of the validation data ({val}) and "
                  "judged on the rest; give a fitting record that slides in both directions to use all of them")
 
 
