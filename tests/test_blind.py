@@ -261,14 +261,17 @@ def test_blind_subset_no_false_alarms(blind_subset):
 
 
 # What the diagnosis reaches on this subset (measured, not chosen: the subset's seeds are the "test"
-# family's): moderate single effects named first 7 of 9 (d0013: a Stribeck dip at vs = 1.7 mm/s is
-# not found, the detection limit of docs/diagnosis.md; d0017: a 41 ms friction lag is named
-# stribeck), parameters within 10 % for 5 of 7 found causes (d0011: a two-sided asymmetry read as
-# an offset, 13 % off; d0018: LuGre sigma0 10.4 % off). The issue's targets (95 %) are asserted as
-# strict xfails, so they show in every run and the day they are met the run says so; the floors
-# keep what is reached.
-NAMED_FIRST_REACHED = 7 / 9
-PARAMS_REACHED = 5 / 7
+# family's): moderate single effects named first 6 of 9 (d0013: a Stribeck dip at vs = 1.7 mm/s is
+# not found, the detection limit of docs/diagnosis.md; d0017: a 41 ms friction lag on records whose
+# sliding samples span 1.6 filter windows, so the force channel is skipped; d0011: a two-sided
+# asymmetry, named `offset` while the force channel also judged stick-slip samples by their excess
+# over the stick set, is read as `stribeck` + `viscous` on the sliding samples alone: the price of
+# that change, which gained six named-first effects and lost one on reporting9, see
+# docs/diagnosis.md), parameters within 10 % for 5 of 6 found causes (d0018: LuGre sigma0 10.4 %
+# off). The issue's targets (95 %) are asserted as strict xfails, so they show in every run and the
+# day they are met the run says so; the floors keep what is reached.
+NAMED_FIRST_REACHED = 6 / 9
+PARAMS_REACHED = 5 / 6
 TARGET_MISSED = "issue 17 target not met on the blind subset (see the comment above NAMED_FIRST_REACHED)"
 
 
@@ -297,7 +300,7 @@ def test_blind_subset_named_first_target(blind_subset):
 def test_blind_subset_parameters_within_10_percent(blind_subset):
     rows, s = blind_subset
     assert s["n_params"] >= 1
-    assert s["n_params"] >= 7                      # as many compared as measured, not a ratio of fewer
+    assert s["n_params"] >= 6                      # as many compared as measured, not a ratio of fewer
     assert s["params"][0] >= PARAMS_REACHED - 1e-9, _bad_parameters(rows)
 
 
