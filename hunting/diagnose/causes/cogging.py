@@ -52,13 +52,15 @@ def hypers(kin, model) -> list:
     """Pitch candidates: the three strongest peaks of the Lomb-Scargle spectrum of the nominal
     force residual (averaged in position bins) against position (wavelengths from 20 samples'
     travel at the slow end of the record's speeds (10th percentile) to half the stroke: two
-    periods), each refined on a +-3 % grid."""
+    periods), each refined on a +-3 % grid of the binned residual, then on the cause's filtered
+    design (:func:`_refined`)."""
     from scipy.signal import lombscargle
     from ..kinematics import residual
     moving = kin.moving
     if moving.sum() < 50:
         return []
-    q, r = kin.q[moving], residual(kin, model)[moving]
+    r_all = residual(kin, model)
+    q, r = kin.q[moving], r_all[moving]
     stroke = float(np.ptp(q))
     # short pitches show where the motion is slow (a pitch shorter than 20 samples' travel at the
     # median speed missed a 0.58 mm cogging moved at 13-58 mm/s, tuning d0088); two periods in
@@ -93,7 +95,7 @@ def hypers(kin, model) -> list:
             fits.append((float(np.sum((rb - rb.mean() - A @ th) ** 2)), pitch))
         best = min(s for s, _ in fits)
         coarse = next(p for s, p in fits if s <= best * (1 + 1e-3))
-        out.append({"pitch": _refined(kin, model, residual(kin, model), coarse)})
+        out.append({"pitch": _refined(kin, model, r_all, coarse)})
     return sorted(out, key=lambda h: h["pitch"])
 
 
