@@ -180,3 +180,17 @@ def test_dwell_reads_the_break_away_force_of_a_closed_form_rest(delta, monkeypat
         assert Fb - F_ramp_only > 0.06
     else:
         assert F_ramp_only == pytest.approx(F[0])
+
+
+def test_dwell_leave_one_out_predicts_each_rest_from_the_others():
+    """Rests whose excess follows level + gain (1 - exp(-t/time)) exactly: each rest predicted by
+    the growth fitted on the others is exact (to the time grid's spacing), and one rest read 0.3
+    N high shows up as its own residual, not spread over the others."""
+    t = np.array([0.02, 0.05, 0.08, 0.15, 0.3, 0.5, 0.8, 1.2])
+    e = 0.1 + 0.8 * (1 - np.exp(-t / 0.2))
+    r = dwell._left_out(t, e)
+    assert np.max(np.abs(r)) < 0.02 * 0.8
+    e2 = e.copy()
+    e2[4] += 0.3
+    r2 = dwell._left_out(t, e2)
+    assert r2[4] > 0.2 and np.max(np.abs(np.delete(r2, 4))) < 0.15

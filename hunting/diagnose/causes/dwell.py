@@ -27,7 +27,11 @@ rank correlation of t and the residual of that null fit, one-sided, calibrated b
 the durations, so pooling them costs no out-of-sample honesty; the old test regressed the
 validation excess minus the fitting mean on the predicted growth without an intercept, so a level
 that differed between the records passed for growth or hid it). Gain, out of sample: the RMS of
-e on the validation data's rests, nominal (the model's break-away force) against extended."""
+e on the validation data's rests, nominal (the model's break-away force) against extended. A fitting
+record with fewer than MIN_RESTS rests (a short record, or one whose programme hardly stops) is
+judged on the rests of both records instead, each predicted by the growth fitted on the others
+(leave-one-out; the parameters are then fitted on all of them): reporting10 d0324, d0436 and
+d0506 had 2 to 4 fitting rests beside 5 to 9 validation rests and were left untested."""
 import numpy as np
 from ._words import _count, _q
 
@@ -169,6 +173,17 @@ def _fit(t, e):
     return (ss, th, tau), float(np.sum((e - e.mean()) ** 2))
 
 
+def _left_out(t, e) -> np.ndarray:
+    """Leave-one-out residuals (m,) [N]: each excess e_k less the growth fitted (:func:`_fit`) on
+    the other rests, at the rest's duration t_k."""
+    out = np.empty_like(e)
+    for k in range(t.size):
+        keep = np.arange(t.size) != k
+        (_, th, tau), _ = _fit(t[keep], e[keep])
+        out[k] = e[k] - float((_design(t[k:k + 1], tau) @ th)[0])
+    return out
+
+
 def growth_test(t, e, s, scale, *, draws: int = DRAWS, seed: int = 0) -> tuple[float, float]:
     """(rho, p): does the break-away excess e (m,) [N] grow with the rest duration t (m,) [s]
     beyond what the direction s (m,) and the reading's error scale (m,) [N] (:func:`rests`)
@@ -243,12 +258,17 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     sigma, metric, nominal, extended, model (the extended model) or reason (why not)."""
     from ..model import Dwell
     t, F, s, scale = rests(fit, model, resolution)
-    if t.size < MIN_RESTS:
-        return dict(reason=f"{_count(t.size, 'rest')} ending in motion in the fitting data (need {MIN_RESTS})", untestable=True)
-    if np.ptp(t) < 0.5 * np.mean(t):
-        return dict(reason=f"the rests all last about {np.mean(t):.3g} s: a dwell effect cannot be told from Fs", untestable=True)
     tv, Fv, sv, scale_v = rests(validate, model, resolution)
-    if tv.size < MIN_VALIDATION:
+    # too few fitting rests: judged by leave-one-out over the rests of both records instead
+    pooled = t.size < MIN_RESTS
+    if pooled and t.size + tv.size < MIN_RESTS + 1:
+        return dict(reason=f"{_count(t.size, 'rest')} ending in motion in the fitting data and {tv.size} in the "
+                           f"validation data (need {MIN_RESTS} in the fitting data, or {MIN_RESTS + 1} in both for a "
+                           "leave-one-out judgement)", untestable=True)
+    tt = np.concatenate([t, tv]) if pooled else t
+    if np.ptp(tt) < 0.5 * np.mean(tt):
+        return dict(reason=f"the rests all last about {np.mean(tt):.3g} s: a dwell effect cannot be told from Fs", untestable=True)
+    if not pooled and tv.size < MIN_VALIDATION:
         return dict(reason=f"{_count(tv.size, 'rest')} ending in motion in the validation data (need {MIN_VALIDATION})",
                     untestable=True)
     e, ev = excess(model, t, F, s), excess(model, tv, Fv, sv)
@@ -258,6 +278,11 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     rho, p = growth_test(np.concatenate([t, tv]), np.concatenate([e, ev]), np.concatenate([s, sv]),
                          np.concatenate([scale, scale_v]))
     out = dict(statistic=float(rho), p_value=float(p))
+    metric = "break-away force RMS error [N], validation rests"
+    if pooled:
+        metric = (f"break-away force RMS error [N], each of the {tt.size} rests of both records predicted by the fit of "
+                  f"the others (the fitting data has {_count(t.size, 'rest')}, {MIN_RESTS} needed to fit on it alone)")
+        t, e = tt, np.concatenate([e, ev])
     (ss, th, tau), ss0 = _fit(t, e)
     dof = t.size - 3
     if th[1] <= 0:
@@ -265,7 +290,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
                                 "not a dwell effect")
     base = model.dwell or Dwell(0.0, 0.0, tau)
     ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau))
-    ev0, ev1 = ev, excess(ext, tv, Fv, sv)
+    ev0, ev1 = (e, _left_out(t, e)) if pooled else (ev, excess(ext, tv, Fv, sv))
     A = _design(t, tau)
     cov = np.linalg.pinv(A.T @ A) * ss / dof
     # the time's standard uncertainty from the curvature of the residual sum of squares in tau
@@ -276,7 +301,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     d = ext.dwell
     return dict(out, parameters={"level": d.level, "gain": d.gain, "time": d.time},
                 sigma={"level": float(np.sqrt(cov[0, 0])), "gain": float(np.sqrt(cov[1, 1])), "time": sig_tau},
-                metric="break-away force RMS error [N], validation rests",
+                metric=metric,
                 nominal=float(np.sqrt(np.mean(ev0 ** 2))), extended=float(np.sqrt(np.mean(ev1 ** 2))), model=ext)
 
 
