@@ -448,3 +448,15 @@ def test_dwell_with_few_fitting_rests_is_judged_over_both_records():
     assert [c.name for c in d.causes] == ["dwell"], (d.rejected, d.untested)
     assert "predicted by the fit of the others" in d.causes[0].gain["metric"]
     assert d.causes[0].parameters["gain"] == pytest.approx(truth["effects"][0]["params"]["gain"], rel=0.25)
+
+
+def test_stribeck_at_the_nominal_velocity_above_most_fitting_speeds():
+    """reporting10 d0359: the static level 7.45 -> 8.56 N at the nominal Stribeck velocity 0.060
+    m/s, above the fitting record's 90th percentile speed (0.049 m/s; it reaches 0.22). The
+    search's grid ended there, a level and a viscous change fitted better than any dip it held,
+    and both were named. With the nominal velocity a candidate wherever the record slides past it,
+    the dip is named alone, Fs within 1 %."""
+    fit, val, model, truth = _dataset("reporting10", 359)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
+    assert d.causes[0].parameters["Fs"] == pytest.approx(truth["effects"][0]["params"]["Fs"], rel=0.01)
