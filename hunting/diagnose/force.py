@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .causes import CAUSES
+from .causes import CAUSES, hyper_keys
 from .kinematics import Kinematics, residual
 from .model import NominalModel
 from .stats import NoiseModel, Samples, out_of_sample
@@ -171,7 +171,8 @@ class Library:
 
         fits = [rss(v.Xf[idx], v.sf[idx]) for v in self.variants[name]]
         j = int(np.argmin(fits))
-        start, keys = self.variants[name][j].hyper, mod.HYPER_KEYS
+        start = self.variants[name][j].hyper
+        keys = hyper_keys(name, start)
         shift = getattr(mod, "shift", None)
 
         def at(x):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .causes import CAUSES
+from .causes import CAUSES, hyper_keys
 from .force import Explanation, Library, unphysical_members
 from .kinematics import Kinematics
 from .stats import gls, instrumented
@@ -67,7 +67,7 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
             v = lib.variants[name][j]
             kk = v.Xf.shape[1]
             th = fixed[name] if name in held else theta[k:k + kk]
-            for key in getattr(CAUSES[name], "HYPER_KEYS", ()):
+            for key in hyper_keys(name, v.hyper):
                 col = _sensitivity(lib, name, v.hyper, key, th, lib.kf)
                 cols.append(col)
                 zcols.append(_sensitivity(lib, name, v.hyper, key, th, lib.kfr) if v.Zf is not None else col)
@@ -111,7 +111,7 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
         return cur
 
     def descend(cur, held, steps):
-        keys = [k for n, _ in cur["members"] for k in getattr(CAUSES[n], "HYPER_KEYS", ())]
+        keys = [k for n, j in cur["members"] for k in hyper_keys(n, lib.variants[n][j].hyper)]
         for _ in range(steps if keys else 0):
             G, GZ = sensitivities(cur["members"], cur["theta"], cur["Z"], held)
             X, Z = cur["X"], cur["Z"]
@@ -139,7 +139,7 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
         for name, j in mem:
             v = lib.variants[name][j]
             h = dict(v.hyper)
-            for key in getattr(CAUSES[name], "HYPER_KEYS", ()):
+            for key in hyper_keys(name, v.hyper):
                 lo, hi = bounds[name][key]
                 h[key] = float(np.clip(v.hyper[key] * np.exp(step[i]), lo, hi))
                 i += 1
@@ -156,7 +156,7 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
         return estimate(np.column_stack([X, G]), None if Z is None else np.column_stack([Z, GZ]), y - cur["s"])[1]
 
     cur = descend(starts(fitted(ex.members, ()), (), {n for n, _ in ex.members}), (), iterations)
-    has_keys = any(getattr(CAUSES[n], "HYPER_KEYS", ()) for n, _ in cur["members"])
+    has_keys = any(hyper_keys(n, lib.variants[n][j].hyper) for n, j in cur["members"])
     k = cur["X"].shape[1]
     # the linear parameters' covariance with the hyper-parameters free, at the free optimum (a
     # held member's coefficients are judged there: is the data's build-up identified at all?)
@@ -173,7 +173,7 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
         hc = (hyper_cov(held_fit, tuple(fixed)), held_fit["X"].shape[1]) if held_fit else (cov_aug, k)
         i = 0
         for name, j in members:
-            for key in getattr(CAUSES[name], "HYPER_KEYS", ()):
+            for key in hyper_keys(name, lib.variants[name][j].hyper):
                 h = lib.variants[name][j].hyper[key]
                 sig.setdefault(name, {})[key] = float(h * np.sqrt(max(hc[0][hc[1] + i, hc[1] + i], 0.0)))
                 i += 1

@@ -9,7 +9,8 @@ returning why a fitted theta is not the physical effect (the cause is then rejec
 optionally ``shift(kin, model, hyper)``: the known, unfitted part (n,) [N] of the extension's
 force change (e.g. the nominal Stribeck dip moved to a new vs). Also: ``FAMILY`` (causes that share
 a signature share it), ``HYPERS`` (continuous hyper-parameters searched, counted in BIC),
-``HYPER_KEYS`` (those refined by Gauss-Newton; optionally ``derived_sigma(parameters, sigma)``
+``HYPER_KEYS`` (those refined by Gauss-Newton; optionally ``hyper_keys(hyper)`` giving those a
+variant has, when some do not apply to it: :func:`hyper_keys`; ``derived_sigma(parameters, sigma)``
 giving the standard uncertainty of parameters computed from them, and ``refine_starts(hyper)``:
 other starting values of hyper-parameters the search holds fixed), ``UNITS`` (of the parameters), ``sentence(p,
 increments, model)`` (the finding in words), ``untestable(kin, model)`` (why a record cannot test
@@ -33,4 +34,15 @@ from . import (asymmetry, cogging, delay, dwell, flexibility, lag, level, mass, 
 CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, level, stribeck, viscous, mass, delay, flexibility, lag, reversal,
                                 presliding, dwell, saturation, quantization)}
 
-__all__ = ["CAUSES"]
+
+
+def hyper_keys(name: str, hyper: dict) -> tuple:
+    """The hyper-parameters refined for a variant of cause ``name``: its ``hyper_keys(hyper)``
+    where it has one (a Stribeck dip taken symmetric on a one-way record has no vs_neg of its
+    own), else its ``HYPER_KEYS``."""
+    mod = CAUSES[name]
+    fn = getattr(mod, "hyper_keys", None)
+    return tuple(fn(hyper)) if fn is not None else tuple(getattr(mod, "HYPER_KEYS", ()))
+
+
+__all__ = ["CAUSES", "hyper_keys"]

@@ -21,6 +21,7 @@ HYPER_KEYS = ("pitch",)
 UNITS = {"pitch": "m", "amplitude_1": "N", "amplitude_2": "N", "amplitude_3": "N"}
 HARMONICS = 3
 MATCH = 0.03          # a model cogging within 3 % of the pitch is the one corrected (the pitch grid's half width)
+MIN_PERIODS = 1.5     # the longest pitch searched: the fitting stroke over this many periods
 GONE = 0.05           # merged amplitude below 5 % of the model's: the model's cogging is not in the data (as offset)
 
 
@@ -51,9 +52,10 @@ def model_coefficients(model, pitch: float) -> np.ndarray:
 def hypers(kin, model) -> list:
     """Pitch candidates: the three strongest peaks of the Lomb-Scargle spectrum of the nominal
     force residual (averaged in position bins) against position (wavelengths from 20 samples'
-    travel at the slow end of the record's speeds (10th percentile) to half the stroke: two
-    periods), each refined on a +-3 % grid of the binned residual, then on the cause's filtered
-    design (:func:`_refined`)."""
+    travel at the slow end of the record's speeds (10th percentile) to the stroke over
+    MIN_PERIODS), and the longest of these wavelengths where the spectrum falls from it; each
+    refined on a +-3 % grid of the binned residual, then on the cause's filtered design
+    (:func:`_refined`)."""
     from scipy.signal import lombscargle
     from ..kinematics import residual
     moving = kin.moving
@@ -66,7 +68,7 @@ def hypers(kin, model) -> list:
     # median speed missed a 0.58 mm cogging moved at 13-58 mm/s, tuning d0088); two periods in
     # the stroke suffice to tell a periodic force (a 1.7 mm pitch over 6.5 mm, d0153)
     step = float(np.percentile(np.abs(np.diff(kin.q)[moving[1:]]), 10))
-    lo, hi = 5 * step, stroke / 2
+    lo, hi = 5 * step, stroke / MIN_PERIODS
     if not (lo > 0 and hi > lo):
         return []
     k = np.geomspace(1 / hi, 1 / lo, 1500)                  # wavenumbers [1/m], 0.2-0.4 % apart
@@ -82,6 +84,12 @@ def hypers(kin, model) -> list:
     power = lombscargle(qb, rb - rb.mean(), 2 * np.pi * k)
     peaks = [i for i in range(1, k.size - 1) if power[i] >= power[i - 1] and power[i] >= power[i + 1]]
     peaks = sorted(peaks, key=lambda i: -power[i])[:3]
+    # and the longest wavelength searched where the spectrum falls from it, as a fourth: a pitch
+    # of about MIN_PERIODS in the stroke shows no interior peak (reporting10 d0428: 0.70 mm over
+    # 1.39 mm; d0512: 4.5 mm over 9.4 mm), and leakage from a slow trend puts power there too,
+    # which must not push a true short pitch out of the three
+    if power[0] > power[1] and 0 not in peaks:
+        peaks.append(0)
     # each peak refined on a +-3 % grid of 0.2 % steps by least squares of the harmonics on the
     # binned residual (the simplest variant, first in the grid, among those within 0.1 % of the
     # best: e.g. not a multiple of the pitch)
