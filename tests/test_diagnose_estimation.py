@@ -431,6 +431,8 @@ def test_a_cause_only_the_validation_record_shows_is_searched_there():
     assert d.causes[0].parameters["Fc"] == pytest.approx(truth["effects"][0]["params"]["Fc"], rel=0.01)
     assert any("cannot show" in n and "alternate blocks" in n for n in d.notes), d.notes
     assert d.extended_model.curve.positive.Fc == pytest.approx(d.causes[0].parameters["Fc"], rel=1e-9)
+    # the summary's force residual is the whole extended model's, with the level in it
+    assert d.extended < 0.3 * d.nominal, (d.nominal, d.extended)
 
 
 def test_a_cause_fitted_on_the_validation_record_holds_beside_the_causes_found_before():

@@ -381,9 +381,18 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
                                              val=validate.name))
     rejected = [dict(r, reason=f"{r['reason']} (fitted on alternate blocks of {validate.name}, judged on the others)")
                 for r in fc2["rejected"]]
+    # the validation record's force residual with the causes found here too (the summary's
+    # "force residual RMS" is the whole extended model's)
+    r_val_ext = fc["r_val_ext"]
+    for c in fc2["causes"]:
+        mod = CAUSES[c.name]
+        shift = getattr(mod, "shift", None)
+        r_val_ext = r_val_ext - (mod.design(kv, ext, c.hyper) @ c.theta + (shift(kv, ext, c.hyper) if shift else 0.0))
+    extended = _rms(r_val_ext[np.isfinite(r_val_ext)]) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
     return dict(fc, causes=list(fc["causes"]) + list(fc2["causes"]), rejected=list(fc["rejected"]) + rejected,
                 model=fc2["model"], alternatives=list(fc["alternatives"]) + list(fc2["alternatives"]),
-                explanations=list(fc["explanations"]) + list(fc2["explanations"]))
+                explanations=list(fc["explanations"]) + list(fc2["explanations"]), r_val_ext=r_val_ext,
+                extended=extended)
 
 
 def measured_saturation(fit: Measurement, validate: Measurement, model: NominalModel, alpha: float):

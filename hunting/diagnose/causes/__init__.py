@@ -35,7 +35,6 @@ CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, level, stribeck, visco
                                 presliding, dwell, saturation, quantization)}
 
 
-
 def hyper_keys(name: str, hyper: dict) -> tuple:
     """The hyper-parameters refined for a variant of cause ``name``: its ``hyper_keys(hyper)``
     where it has one (a Stribeck dip taken symmetric on a one-way record has no vs_neg of its
