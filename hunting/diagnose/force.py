@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .causes import CAUSES, hyper_keys
+from .causes import CAUSES, hyper_keys, untestable
 from .kinematics import Kinematics, residual
 from .model import NominalModel
 from .stats import NoiseModel, Samples, out_of_sample
@@ -137,8 +137,7 @@ class Library:
         self.Sf, self.Sv = Samples.thin(used_f, step), Samples.thin(used_v, step)
         for name in names:
             mod = CAUSES[name]
-            why = getattr(mod, "untestable", lambda *a: None)(kf, model)
-            why = why or getattr(mod, "untestable", lambda *a: None)(kv, model)
+            why = untestable(name, kf, model) or untestable(name, kv, model)
             if why:
                 self.untested[name] = why
                 continue

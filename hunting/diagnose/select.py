@@ -42,7 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import SystemDefinitionError
-from .causes import CAUSES
+from .causes import CAUSES, untestable
 from .data import Measurement
 from .kinematics import Kinematics, kinematics, reference_kinematics, used_samples
 from .model import NominalModel
@@ -326,24 +326,16 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
     record sliding one way, where a level is an offset, left untested). Their rows in
     ``untested`` are replaced by what that search says.
     fc is returned unchanged when there are none or the parts are not :func:`_informative`."""
-    cross = {}
-    for n in names:
-        why = getattr(CAUSES[n], "untestable", lambda *a: None)
-        reason = why(kf, fc["model"])
-        if reason and not why(kv, fc["model"]):
-            cross[n] = reason
-    if not cross:
-        return fc
     ext = fc["model"]
-    parts = _interleaved(validate, ext, sensor, window)
+    reasons = {n: untestable(n, kf, ext) for n in names}
+    cross = {n: r for n, r in reasons.items() if r and not untestable(n, kv, ext)}
+    parts = _interleaved(validate, ext, sensor, window) if cross else None
     if parts is None:
         return fc
     fit2, val2, w2, kf2, kv2 = parts
-    if any(getattr(CAUSES[n], "untestable", lambda *a: None)(k, ext) for n in cross for k in (kf2, kv2)):
-        cross = {n: r for n, r in cross.items()
-                 if not any(getattr(CAUSES[n], "untestable", lambda *a: None)(k, ext) for k in (kf2, kv2))}
-        if not cross:
-            return fc
+    cross = {n: r for n, r in cross.items() if not (untestable(n, kf2, ext) or untestable(n, kv2, ext))}
+    if not cross:
+        return fc
     max_causes, alpha, min_gain, alpha_reference = rule
     # judged from the nominal model among the causes found on the fitting data (refitted: fitted
     # on that record alone they carry its errors; reporting10 d0370, an offset 7 % high on a
@@ -366,10 +358,8 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
     kept = {c.name for c in fc2["causes"]}
     fc2["rejected"] = [r for r in judged["rejected"] if r["name"] in cross and r["name"] not in kept] + [
         r for r in fc2["rejected"] if r["name"] in cross]
-    for c in judged["causes"]:
-        if c.name in cross and c.name not in kept:
-            fc2["rejected"].append(dict(name=c.name, step="refit", reason="it does not hold on top of the causes found "
-                                                                          "on the fitting data"))
+    fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "
+                                                          "data") for n in held if n not in kept]
     for c in judged["causes"]:
         if c.name not in cross and c.name not in found:
             fc2["rejected"] = [dict(r, reason=f"{r['reason']}; {c.name} explains these data in its place")

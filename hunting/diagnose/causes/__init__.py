@@ -44,4 +44,11 @@ def hyper_keys(name: str, hyper: dict) -> tuple:
     return tuple(fn(hyper)) if fn is not None else tuple(getattr(mod, "HYPER_KEYS", ()))
 
 
-__all__ = ["CAUSES", "hyper_keys"]
+def untestable(name: str, kin, model) -> str | None:
+    """Why a record (its Kinematics) cannot test cause ``name`` against ``model`` (its
+    ``untestable`` hook), or None when it can or the cause has no such hook."""
+    fn = getattr(CAUSES[name], "untestable", None)
+    return fn(kin, model) if fn is not None else None
+
+
+__all__ = ["CAUSES", "hyper_keys", "untestable"]
