@@ -194,3 +194,47 @@ def test_dwell_leave_one_out_predicts_each_rest_from_the_others():
     e2[4] += 0.3
     r2 = dwell._left_out(t, e2)
     assert r2[4] > 0.2 and np.max(np.abs(np.delete(r2, 4))) < 0.15
+
+
+def _level_rests(excess=1.9, scale=0.06, n=5, Fs=10.0):
+    """Rests of 0.7-2 s in both directions whose break-away force exceeds Fs by ``excess`` [N]
+    after each (a growth complete before the shortest rest), with reading scales ``scale`` [N]."""
+    model = NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0},
+                                    "friction": {"law": "coulomb-viscous", "Fc": Fs, "b": 0.0}})
+    t = np.linspace(0.7, 2.0, n)
+    s = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    rng = np.random.default_rng(3)
+    F = s * (Fs + excess + 0.02 * rng.standard_normal(n))
+    return t, F, s, np.full(n, scale), model
+
+
+def test_dwell_level_verdict_fits_the_break_away_excess_every_rest_shows():
+    """A break-away 1.9 N above Fs after every rest: the growth test's null holds a level per
+    direction and cannot see it; the level verdict names it with the gain within 2 % and its
+    time below the shortest rest, and each rest's leave-one-out prediction is the mean of the
+    others (checked by brute force)."""
+    t, F, s, scale, model = _level_rests()
+    v = dwell.level_verdict(t, F, s, scale, model)
+    assert v is not None and v["significant"] and v["p_value"] is None and v["rivals"] == ("stribeck",)
+    assert v["parameters"]["gain"] == pytest.approx(1.9, rel=0.02)
+    assert v["parameters"]["time"] <= t.min() / 5 + 1e-12
+    e = dwell.excess(model, t, F, s)
+    w = 1 - np.exp(-t / v["parameters"]["time"])
+    loo = [e[k] - w[k] * np.delete(w * e, k).sum() / np.delete(w * w, k).sum() for k in range(t.size)]
+    assert v["extended"] == pytest.approx(np.sqrt(np.mean(np.square(loo))), rel=1e-9)
+    assert v["nominal"] == pytest.approx(1.9, rel=0.02) and v["extended"] < 0.05
+
+
+@pytest.mark.parametrize("case", ["one direction", "below the ratio", "two rests"])
+def test_dwell_level_verdict_needs_every_rest_in_both_directions(case):
+    """No verdict where the excess could be an asymmetry (one direction), where one rest's excess
+    is within three times its reading scale (a ramp read late), or with fewer than three rests."""
+    t, F, s, scale, model = _level_rests()
+    if case == "one direction":
+        F, s = np.abs(F), np.ones_like(s)
+    elif case == "below the ratio":
+        scale = scale.copy()
+        scale[2] = 0.7
+    else:
+        t, F, s, scale = t[:2], F[:2], s[:2], scale[:2]
+    assert dwell.level_verdict(t, F, s, scale, model) is None

@@ -66,7 +66,7 @@ def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
             g = c.gain
             rel = 1 - g["extended"] / g["nominal"] if g["nominal"] else 0.0
             label = g["metric"].split(" [")[0]
-            out.append(wrap(f"evidence: {_p_text(c.p_value)}; {label}: {_metric_value(g['metric'], g['nominal'])} "
+            out.append(wrap(f"evidence: {g.get('evidence') or _p_text(c.p_value)}; {label}: {_metric_value(g['metric'], g['nominal'])} "
                             f"without it -> {_metric_value(g['metric'], g['extended'])} with it ({_pct(rel)} lower)",
                             "     ", "       "))
     else:
