@@ -510,3 +510,15 @@ def test_dwell_break_away_excess_not_named_where_a_stribeck_change_is_untested()
     assert d.causes == []
     row = next(r for r in d.rejected if r["name"] == "dwell")
     assert "stribeck would explain it as well and the force channel could not test it" in row["reason"]
+
+
+def test_dwell_break_away_excess_beside_a_coulomb_level():
+    """reporting10 d0584: a Coulomb level 6 % low and a dwell growth of 7.2 N complete in 35 ms;
+    the rests last 0.5-1.75 s. The force channel names the level; a Stribeck change alone would
+    also lower the residual, but the level (its family) already fits the curve's static force, so
+    the break-away excess above it is named as dwell, gain within 5 % (only the level before)."""
+    fit, val, model, truth = _dataset("reporting10", 584)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert sorted(c.name for c in d.causes) == ["dwell", "level"], [(c.name, c.parameters) for c in d.causes]
+    gain = next(e["params"]["gain"] for e in truth["effects"] if e["cause"] == "dwell")
+    assert next(c for c in d.causes if c.name == "dwell").parameters["gain"] == pytest.approx(gain, rel=0.05)

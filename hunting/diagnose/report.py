@@ -46,6 +46,11 @@ def _p_text(p) -> str:
     return "-" if p is None else ("p < 1e-16" if p < 1e-16 else f"p = {p:.2g}")
 
 
+def _evidence_text(c) -> str:
+    """What admitted a cause: its p-value, or the rule it met where it has none."""
+    return c.gain.get("evidence") or _p_text(c.p_value)
+
+
 def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
     """The diagnosis as the ``hunting diagnose`` command prints it: what the simulation gets
     wrong (one sentence per finding), each cause's final parameters with units and standard
@@ -66,7 +71,7 @@ def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
             g = c.gain
             rel = 1 - g["extended"] / g["nominal"] if g["nominal"] else 0.0
             label = g["metric"].split(" [")[0]
-            out.append(wrap(f"evidence: {g.get('evidence') or _p_text(c.p_value)}; {label}: {_metric_value(g['metric'], g['nominal'])} "
+            out.append(wrap(f"evidence: {_evidence_text(c)}; {label}: {_metric_value(g['metric'], g['nominal'])} "
                             f"without it -> {_metric_value(g['metric'], g['extended'])} with it ({_pct(rel)} lower)",
                             "     ", "       "))
     else:
@@ -267,7 +272,7 @@ def write_report(dg: Diagnosis, directory) -> Path:
                     f"<td>{html.escape(_metric_value('', g['extended'], g['unit']))}</td></tr>" for g in dg.gains())
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in dg.notes)
     rows = "".join(
-        f"<tr><td>{i + 1}</td><td>{html.escape(c.name)}</td><td>{c.score:.3g}</td><td>{html.escape(_p_text(c.p_value))}</td>"
+        f"<tr><td>{i + 1}</td><td>{html.escape(c.name)}</td><td>{c.score:.3g}</td><td>{html.escape(_evidence_text(c))}</td>"
         f"<td>{html.escape(parameter_text(c.name, c.parameters, c.sigma))}</td>"
         f"<td>{html.escape(c.gain['metric'])}: {c.gain['nominal']:.4g} → {c.gain['extended']:.4g}</td></tr>"
         for i, c in enumerate(dg.causes))
@@ -283,7 +288,7 @@ def write_report(dg: Diagnosis, directory) -> Path:
 <h1>Diagnosis</h1>
 {'<ul>' + finds + '</ul>' if finds else '<p>' + html.escape(_sentence_case(no_cause_headline(dg))) + '.</p>'}
 {'<h2>Notes</h2><ul>' + notes + '</ul>' if notes else ''}
-<table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>p</th><th>parameters</th>
+<table border="1" cellpadding="4"><tr><th>rank</th><th>cause</th><th>score</th><th>evidence</th><th>parameters</th>
 <th>validation metric: nominal → extended</th></tr>{rows}</table>
 <table border="1" cellpadding="4"><tr><th>validation metric</th><th>measured</th><th>nominal</th><th>extended</th></tr>{gains}</table>
 {'<h2>Alternatives</h2><ul>' + alt + '</ul>' if alt else ''}
