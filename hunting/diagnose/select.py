@@ -67,8 +67,9 @@ class Cause:
     parameters : final values (those the extended model holds) and sigma their standard
     uncertainties (None where not estimated); gain : the validation metric of the model without
     and with it (metric, nominal, extended; evidence: the rule that admitted it where that is not
-    a p-value, p_value then None); increments : parameters' change against the nominal model; family : causes that
-    share a signature share it; hyper : the hyper-parameter variant; theta : fitted coefficients."""
+    a p-value, p_value then None); increments : parameters' change against the nominal model;
+    family : causes that share a signature share it; hyper : the hyper-parameter variant; theta :
+    fitted coefficients."""
 
     name: str
     score: float
