@@ -522,3 +522,15 @@ def test_dwell_break_away_excess_beside_a_coulomb_level():
     assert sorted(c.name for c in d.causes) == ["dwell", "level"], [(c.name, c.parameters) for c in d.causes]
     gain = next(e["params"]["gain"] for e in truth["effects"] if e["cause"] == "dwell")
     assert next(c for c in d.causes if c.name == "dwell").parameters["gain"] == pytest.approx(gain, rel=0.05)
+
+
+def test_dwell_growth_not_below_the_coulomb_level_on_a_stribeck_change():
+    """reporting12 d0429: a Stribeck change (Fs 0.78 N, Fc 0.45 N). The break-away readings rise
+    with the rest (p < 1e-3), and a free growth fit put the level at -0.86 N and the gain at 4.4 N
+    (5.6 times Fs): `dwell` was named first, before the Stribeck change. With the break-away held
+    at or above the Coulomb level the growth falls, and only the Stribeck change is named."""
+    fit, val, model, truth = _dataset("reporting12", 429)
+    assert [e["cause"] for e in truth["effects"]] == ["stribeck"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
+    assert "falls with the rest" in next(r for r in d.rejected if r["name"] == "dwell")["reason"]

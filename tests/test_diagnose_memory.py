@@ -238,3 +238,22 @@ def test_dwell_level_verdict_needs_every_rest_in_both_directions(case):
     else:
         t, F, s, scale = t[:2], F[:2], s[:2], scale[:2]
     assert dwell.level_verdict(t, F, s, scale, model) is None
+
+
+def test_dwell_growth_fit_keeps_the_break_away_above_the_coulomb_level():
+    """A growth whose free fit runs its level below -(Fs - Fc) (a contact breaking away below the
+    force it slides at) is refitted with the level at that bound and the gain alone: exact data
+    level -0.3 + gain 1 (1 - exp(-t / 0.2)) with a bound of -0.1 give level -0.1 and a least-squares
+    gain at the same time constant (checked against numpy's); a level above the bound is kept."""
+    t = np.array([0.02, 0.05, 0.1, 0.2, 0.4, 0.8, 1.2])
+    e = -0.3 + 1.0 * (1 - np.exp(-t / 0.2))
+    ss_free, th_free = dwell._ls(t, e, 0.2)
+    assert th_free == pytest.approx([-0.3, 1.0], abs=1e-9) and ss_free < 1e-18
+    ss, th = dwell._ls(t, e, 0.2, lo=-0.1)
+    w = 1 - np.exp(-t / 0.2)
+    g = np.linalg.lstsq(w[:, None], e + 0.1, rcond=None)[0][0]
+    assert th == pytest.approx([-0.1, g], rel=1e-12) and ss == pytest.approx(np.sum((e + 0.1 - g * w) ** 2))
+    assert dwell._ls(t, e, 0.2, lo=-0.5)[1] == pytest.approx([-0.3, 1.0], abs=1e-9)
+    model = NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0},
+                                    "friction": {"law": "stribeck", "Fc": 1.0, "Fs": 1.4, "vs": 0.01, "b": 0.0}})
+    assert dwell.lowest_level(model) == pytest.approx(-0.4)

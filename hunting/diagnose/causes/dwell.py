@@ -157,32 +157,47 @@ def _design(t, tau):
     return np.column_stack([np.ones_like(t), 1 - np.exp(-t / tau)])
 
 
-def _ls(t, e, tau) -> tuple[float, np.ndarray]:
-    """(residual sum of squares, [level, gain]) at time constant tau."""
+def _ls(t, e, tau, lo: float = -np.inf) -> tuple[float, np.ndarray]:
+    """(residual sum of squares, [level, gain]) at time constant tau, the level at least ``lo``
+    (at ``lo`` and the gain refitted where the free fit falls below it)."""
     A = _design(t, tau)
     th, *_ = np.linalg.lstsq(A, e, rcond=None)
+    if th[0] < lo:
+        w = A[:, 1]
+        th = np.array([lo, float(w @ (e - lo)) / max(float(w @ w), 1e-300)])
     return float(np.sum((e - A @ th) ** 2)), th
 
 
-def _fit(t, e):
+def _fit(t, e, lo: float = -np.inf):
     """Best (ss, [level, gain], time) over the time grid, and the constant-only ss. The grid
     starts at the shortest rest: a growth that completes before any rest ends is a level, and a
     time below it let level and gain run off together (tuning d0237: level -72 N, gain 74 N, time
     6 ms for a true 1.9 N over 32 ms; from the shortest rest 0.5, 1.4 N and 29 ms; the gain's
     median error on the 40 testable dwell records of tuning, reporting5 and reporting6 2.8 ->
-    0.63 times the truth)."""
+    0.63 times the truth). The level is held at ``lo`` or above (:func:`lowest_level`)."""
     grid = np.geomspace(t.min(), 5 * t.max(), 41)
-    ss, th, tau = min(((*_ls(t, e, x), float(x)) for x in grid), key=lambda r: r[0])
+    ss, th, tau = min(((*_ls(t, e, x, lo), float(x)) for x in grid), key=lambda r: r[0])
     return (ss, th, tau), float(np.sum((e - e.mean()) ** 2))
 
 
-def _left_out(t, e) -> np.ndarray:
+def lowest_level(model) -> float:
+    """The smallest level increment [N] a fitted growth may have: the break-away force after the
+    shortest rest, Fs + level, not below the Coulomb level Fc in either direction (a contact that
+    breaks away below the force it slides at is not physical). Free, the level and the gain of a
+    stiff fit traded off: reporting12 d0429, a Stribeck change with Fs - Fc = 0.25 N, got level
+    -0.86 N and gain 4.4 N (5.6 times Fs), passing as dwell; tuning d0174, a dwell of 5 N, got
+    -8.4 N and 11 N."""
+    base = model.dwell.level if model.dwell is not None else 0.0
+    return -min(c.Fs - c.Fc for c in (model.curve.positive, model.curve.negative)) - base
+
+
+def _left_out(t, e, lo: float = -np.inf) -> np.ndarray:
     """Leave-one-out residuals (m,) [N]: each excess e_k less the growth fitted (:func:`_fit`) on
     the other rests, at the rest's duration t_k."""
     out = np.empty_like(e)
     for k in range(t.size):
         keep = np.arange(t.size) != k
-        (_, th, tau), _ = _fit(t[keep], e[keep])
+        (_, th, tau), _ = _fit(t[keep], e[keep], lo)
         out[k] = e[k] - float((_design(t[k:k + 1], tau) @ th)[0])
     return out
 
@@ -343,24 +358,28 @@ def _growth_verdict(t, F, s, scale, tv, Fv, sv, scale_v, model) -> dict:
         metric = (f"break-away force RMS error [N], each of the {tt.size} rests of both records predicted by the fit of "
                   f"the others (the fitting data has {_count(t.size, 'rest')}, {MIN_RESTS} needed to fit on it alone)")
         t, e = tt, np.concatenate([e, ev])
-    (ss, th, tau), ss0 = _fit(t, e)
+    lo = lowest_level(model)
+    (ss, th, tau), ss0 = _fit(t, e, lo)
     dof = t.size - 3
     if th[1] <= 0:
         return dict(out, reason=f"the break-away force falls with the rest in the fitting data (gain {th[1]:.3g} N): "
                                 "not a dwell effect")
     base = model.dwell or Dwell(0.0, 0.0, tau)
     ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau))
-    ev0, ev1 = (e, _left_out(t, e)) if pooled else (ev, excess(ext, tv, Fv, sv))
+    ev0, ev1 = (e, _left_out(t, e, lo)) if pooled else (ev, excess(ext, tv, Fv, sv))
     A = _design(t, tau)
-    cov = np.linalg.pinv(A.T @ A) * ss / dof
+    bound = th[0] <= lo       # the level held at its bound: the gain alone was fitted
+    cov = (np.diag([np.nan, 1.0 / max(float(A[:, 1] @ A[:, 1]), 1e-300)]) if bound
+           else np.linalg.pinv(A.T @ A)) * ss / dof
     # the time's standard uncertainty from the curvature of the residual sum of squares in tau
     h = 0.05 * tau
-    ssp = [_ls(t, e, x)[0] for x in (tau - h, tau + h)]
+    ssp = [_ls(t, e, x, lo)[0] for x in (tau - h, tau + h)]
     curv = (ssp[0] - 2 * ss + ssp[1]) / h ** 2
     sig_tau = float(np.sqrt(2 * ss / dof / curv)) if curv > 0 else None
     d = ext.dwell
     return dict(out, parameters={"level": d.level, "gain": d.gain, "time": d.time},
-                sigma={"level": float(np.sqrt(cov[0, 0])), "gain": float(np.sqrt(cov[1, 1])), "time": sig_tau},
+                sigma={"level": None if bound else float(np.sqrt(cov[0, 0])), "gain": float(np.sqrt(cov[1, 1])),
+                       "time": sig_tau},
                 metric=metric,
                 nominal=float(np.sqrt(np.mean(ev0 ** 2))), extended=float(np.sqrt(np.mean(ev1 ** 2))), model=ext)
 
