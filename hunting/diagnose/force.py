@@ -279,16 +279,17 @@ class Library:
         G, iy = self.G, self.G.shape[0] - 1
         yy = G[iy, iy] - 2 * sum(G[iy, s] for s in sh) + sum(G[s, t] for s in sh for t in sh)
         if cols:
-            A = G[np.ix_(cols, cols)]
-            b = G[cols, iy] - (G[np.ix_(cols, sh)].sum(axis=1) if sh else 0.0)
+            ci = np.asarray(cols)[:, None]          # the block's rows (np.ix_ costs 6 times as much)
+            A = G[ci, cols]
+            b = G[cols, iy] - (G[ci, sh].sum(axis=1) if sh else 0.0)
             theta = np.linalg.lstsq(A, b, rcond=None)[0]
             rss = float(yy - theta @ b)
             if self.instrumented(members):
                 # the coefficients by instrumental variables; the set's score stays the GLS fit's
                 # (the search ranks what a set can explain, the estimate is what it reports)
                 si = [s - self.n_cols for s in sh]
-                zb = self.Zy[cols] - (self.ZS[np.ix_(cols, si)].sum(axis=1) if si else 0.0)
-                theta = np.linalg.lstsq(self.ZX[np.ix_(cols, cols)], zb, rcond=None)[0]
+                zb = self.Zy[cols] - (self.ZS[ci, si].sum(axis=1) if si else 0.0)
+                theta = np.linalg.lstsq(self.ZX[ci, cols], zb, rcond=None)[0]
         else:
             theta, rss = np.zeros(0), float(yy)
         rss = max(rss, 1e-300 * max(yy, 1.0))
@@ -320,7 +321,7 @@ class Library:
                 continue
             # |X th + S_s|^2 / m from the unwhitened Gram matrix of [X, S] (the part itself is
             # thousands of samples long, and the search asks this of every set it fits)
-            sq = th @ U[np.ix_(cols, cols)] @ th
+            sq = th @ U[np.asarray(cols)[:, None], cols] @ th
             if s is not None:
                 js = self.n_cols + s
                 sq += 2.0 * th @ U[cols, js] + U[js, js]
