@@ -729,9 +729,8 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     row = dict(name=mod.NAME, step="own", statistic=v.get("statistic"), p_value=v.get("p_value"))
     if "reason" in v:
         return None, dict(row, validation_gain=None, reason=v["reason"], untested=bool(v.get("untestable"))), model
-    gain = 1 - v["extended"] / max(v["nominal"], 1e-300)
     if first is not None:
-        return None, dict(row, validation_gain=gain, reason=first), model
+        return None, dict(row, validation_gain=_own_gain(v), reason=first), model
     return (Cause(mod.NAME, v["nominal"] / max(v["extended"], 1e-300) - 1, v["statistic"], v["p_value"],
                   v["parameters"], v["sigma"], dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"],
                                                     **({"evidence": v["evidence"]} if "evidence" in v else {})),
@@ -747,17 +746,23 @@ def _unruled_rivals(rivals, found: list, rejected: list, untested: list, min_gai
     or it was tested and lowered the validation residual alone by less than min_gain (the sliding
     data do not ask for it: reporting11 d0422, a dwell effect on a one-way record where a Stribeck
     change gained 3.7 %, p = 0.053)."""
-    gains = {r["name"]: r.get("validation_gain") for r in rejected}
+    rows = {r["name"]: r for r in rejected}
     for name in rivals:
         if any(c.family == getattr(CAUSES[name], "FAMILY", name) for c in found):
             continue
-        g = gains.get(name)
+        g = rows.get(name, {}).get("validation_gain")
         if g is None:
-            why = next((u["reason"] for u in untested if u["name"] == name), "it was not searched")
+            why = next((u["reason"] for u in untested if u["name"] == name),
+                       rows[name]["reason"] if name in rows else "it was not searched")
             return f"{name} would explain it as well and the force channel could not test it ({why})"
         if g >= min_gain:
             return f"{name} would explain it as well: alone it lowers the validation force residual by {g:.0%}"
     return None
+
+
+def _own_gain(v: dict) -> float:
+    """The relative fall of an own-evidence verdict's validation metric, nominal to extended."""
+    return 1 - v["extended"] / max(v["nominal"], 1e-300)
 
 
 def _own_failure(v: dict, alpha: float, min_gain: float) -> str | None:
@@ -765,7 +770,7 @@ def _own_failure(v: dict, alpha: float, min_gain: float) -> str | None:
     when it does."""
     if "reason" in v:
         return v["reason"]
-    gain = 1 - v["extended"] / max(v["nominal"], 1e-300)
+    gain = _own_gain(v)
     why = []
     if "significant" in v:
         if not v["significant"]:
