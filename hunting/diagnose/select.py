@@ -8,8 +8,10 @@ The rule (stated in every report, :data:`RULE`):
   residual of every candidate at once; a cause of the best explanation is kept when it explains
   the validation residual of the others out of sample (one-sided test, prewhitened, with an
   autocorrelation- and level-consistent standard error: p < alpha; when the reference moves,
-  also its prediction along the reference trajectory, p < alpha_reference: feedback puts the
-  sensor's and the actuator's noise into the measured regressors, not into the reference's),
+  also its prediction along the reference trajectory, p < alpha_reference, and, with a controller
+  in the model, that prediction's shape, alone and summed with the other noise-fed causes',
+  explains at least REFERENCE_GAIN x min_gain of it: feedback puts the sensor's and the actuator's noise into the measured
+  regressors, not into the reference's),
   dropping it grows the validation RMS by at least ``min_gain``, and the whole set beats each of
   its subsets by as much; what fails is removed and the rest refitted, and when nothing of the
   set holds, the BIC-best set without the causes that failed is judged next; a special case
@@ -51,7 +53,8 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once; each "
         "of its causes kept when it explains the validation residual of the others out of sample (one-sided test, "
         "prewhitened, autocorrelation-consistent standard error, Student's t with the validation data's filter windows less one as degrees of freedom, p < {alpha:g}; with a moving reference its prediction "
-        "along the reference too, p < {alpha_reference:g}), dropping it grows the validation RMS by at least "
+        "along the reference too, p < {alpha_reference:g}, and, with a controller in the model, that prediction's shape, alone and with "
+        "the other noise-fed causes', explains at least {reference_gain:.1%} of it), dropping it grows the validation RMS by at least "
         "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by as much, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%}")
 CRITERION = RULE
@@ -207,7 +210,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     kv = kinematics(validate, model.cm, window=window, **sensor)
     check_units(kf, model, fit.name)
     check_units(kv, model, validate.name)
-    crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference)
+    from .force import REFERENCE_GAIN
+    crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
+                      reference_gain=REFERENCE_GAIN * min_gain)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
