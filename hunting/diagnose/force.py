@@ -576,7 +576,7 @@ def _tests(lib: Library, current: Explanation, noise_v, floor: float) -> tuple[d
     # 4.6 windows of validation data, an 'offset' at t = 4.3, normal p = 8.5e-6)
     dof = lib.used_v.sum() * lib.kv.dt / lib.kv.window - 1.0
     pred = lib.prediction(current, "v")
-    noise_free = {}         # {name: (measured part, [its part along each noise-free loop])} of noise-fed members
+    noise_free = {}   # noise-fed members: {name: (measured part, part along the nominal loop, along the extended or None)}
     for name in current.names:
         rest = tuple(n for n in current.names if n != name)
         start = {n: j for n, j in current.members if n != name}

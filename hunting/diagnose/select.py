@@ -10,8 +10,8 @@ The rule (stated in every report, :data:`RULE`):
   autocorrelation- and level-consistent standard error: p < alpha; when the reference moves,
   also its prediction along the reference trajectory, p < alpha_reference, and, with a controller
   in the model, that prediction's shape, alone and summed with the other noise-fed causes',
-  explains at least REFERENCE_GAIN x min_gain of it: feedback puts the sensor's and the actuator's noise into the measured
-  regressors, not into the reference's),
+  explains at least REFERENCE_GAIN x min_gain of it: feedback puts the sensor's and the
+  actuator's noise into the measured regressors, not into the reference's),
   dropping it grows the validation RMS by at least ``min_gain``, and the whole set beats each of
   its subsets by as much; what fails is removed and the rest refitted, and when nothing of the
   set holds, the BIC-best set without the causes that failed is judged next; a special case
