@@ -442,8 +442,8 @@ def _instrument_strength(X: np.ndarray, Z: np.ndarray) -> float:
 
 def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_reference: float = 0.01) -> dict:
     """The force channel's explanation (module docstring): {"explanation", "tests" (per member:
-    gamma, t, p, gain, rms without), "rejected" (rows), "ranking" (every set searched, best
-    first: (bic, names)), "noise_val"}."""
+    :func:`_tests`'s row), "rejected" (rows), "ranking" (every set searched, best first: (bic,
+    names)), "noise_val", "fits"}."""
     names = list(lib.variants)
     sets = [()]
     for k in range(1, min(max_causes, len(names)) + 1):
@@ -567,7 +567,10 @@ def _fails(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bo
 def _tests(lib: Library, current: Explanation, noise_v, floor: float) -> tuple[dict, float]:
     """Per member of ``current``: its out-of-sample test on the validation data (gamma, t,
     p_value), its drop-one gain, the validation RMS with and without it and, for noise-fed causes
-    with an instrument, p_reference (module docstring); and the set's validation RMS."""
+    with an instrument, p_reference (module docstring), and with a controller in the model
+    gain_reference (its part's shape along the noise-free loops, :func:`_shape_gain`) and, with
+    two or more of them, gain_reference_set ((the same of their summed parts, their names)); and
+    the set's validation RMS."""
     Sv = lib.Sv
     tests = {}
     rms_full = lib.validation_rms(current)
