@@ -186,6 +186,33 @@ def test_reversal_reports_the_extension_own_bristle_stiffness():
     assert 0.7 < c.parameters["scale"] < 1.3
 
 
+def test_stiff_bristles_without_creep_are_found_by_the_loop():
+    """LuGre bristles (reporting13 d0449, sigma0 = 1.22e5 N/m: friction builds up over 17 um)
+    on a loop whose rests show no creep beyond the sensor's counts: the force channel's samples
+    leave out the turns and stops where the bristles act, and the start code reported nothing.
+    Re-simulated with bristles fitted on the fitting record's position, the loop follows both
+    records by more than LOOP_GAIN better: presliding, sigma0 within 5 %."""
+    from hunting.diagnose.causes import presliding
+    fit, val, model, truth = _dataset("reporting13", 449)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["presliding"], [(c.name, c.parameters) for c in d.causes]
+    c = d.causes[0]
+    assert c.parameters["sigma0"] == pytest.approx(truth["effects"][0]["params"]["sigma0"], rel=0.05)
+    assert c.p_value is None and "re-simulated with LuGre bristles" in c.gain["evidence"]
+    assert 1 - c.gain["extended"] / c.gain["nominal"] >= presliding.LOOP_GAIN
+
+
+def test_loop_evidence_below_its_bar_reports_nothing():
+    """A clean record (reporting14 d0100) whose loop LuGre bristles follow 37 % better on the
+    fitting record: below LOOP_GAIN, rejected with both the creep test's and the loop's reason."""
+    fit, val, model, truth = _dataset("reporting14", 100)
+    assert truth["causes"] == []
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == []
+    row = next(r for r in d.rejected if r["name"] == "presliding")
+    assert row["step"] == "loop" and "50% needed" in row["reason"] and "; and LuGre bristles cut" in row["reason"]
+
+
 @pytest.mark.parametrize("family, index", [("reporting5", 491), ("reporting7", 519)])
 def test_presliding_stiffness_is_fitted_on_the_creep(family, index):
     """Creep where the model sticks (reporting5 d0491, sigma0 = 6.5e5 N/m; reporting7 d0519,

@@ -25,6 +25,11 @@ The rule (stated in every report, :data:`RULE`):
   (force-extended) model says the mass sticks: a chi-square test of the motion there against the
   sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
   the re-simulated position error (controller known) or in the stick-segment displacement.
+  Where that test has nothing (no creep beyond the counts, or too few stick samples) and the
+  loop can be re-simulated, presliding's loop evidence judges bristles too stiff to creep at rest
+  by what they do where the loop turns and stops: fitted on the fitting record's re-simulated
+  position, they must cut both records' position error by at least ``LOOP_GAIN``
+  (:func:`~hunting.diagnose.causes.presliding.loop_evidence`).
   Presliding and reversal are one family (LuGre bristles): when the force channel found
   reversal, presliding is not tested again.
 
@@ -56,7 +61,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "along the reference too, p < {alpha_reference:g}, and, with a controller in the model, that prediction's shape, alone and with "
         "the other noise-fed causes', explains at least {reference_gain:.1%} of it), dropping it grows the validation RMS by at least "
         "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by as much, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
-        "p < {alpha:g} and a validation gain of at least {min_gain:.0%}")
+        "p < {alpha:g} and a validation gain of at least {min_gain:.0%}; presliding, where no creep shows at rest, also "
+        "when LuGre bristles fitted on the fitting record's re-simulated loop cut both records' position error by at "
+        "least {loop_gain:.0%}")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -211,8 +218,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     check_units(kf, model, fit.name)
     check_units(kv, model, validate.name)
     from .force import REFERENCE_GAIN
+    from .causes.presliding import LOOP_GAIN
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
-                      reference_gain=REFERENCE_GAIN * min_gain)
+                      reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
@@ -788,12 +796,14 @@ def _own_failure(v: dict, alpha: float, min_gain: float) -> str | None:
 
 
 def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
-    """Judge one stick-channel cause (module docstring). Returns (Cause or None, rejected row or
+    """Judge one stick-channel cause (module docstring): its creep evidence where the model
+    sticks, and where that has none and the loop can be re-simulated, its loop evidence
+    (``loop_evidence``: presliding's stiff bristles). Returns (Cause or None, rejected row or
     None, the model extended by it when accepted)."""
     from .resimulate import position_rms_error, resolution_of
     segs = mod.segments(kf, model)
     if sum(b - a + 1 for a, b in segs) < 200:
-        return None, None, model
+        return _loop_channel(mod, fit, val, model, can_sim, None, "fewer than 200 samples where the model sticks")
     res = model.resolution if model.resolution is not None else resolution_of(fit.q)
     chi2, p = mod.evidence(kf, model, segs, res)
 
@@ -801,10 +811,11 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
         row = dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=gain)
         return None, (row if reason is None else dict(row, reason=reason)), model
     if p >= alpha:
-        return reject(reason="no motion beyond quantization and sensor noise where the model sticks")
+        return _loop_channel(mod, fit, val, model, can_sim, (chi2, p),
+                             "no motion beyond quantization and sensor noise where the model sticks")
     why = mod.not_following(kf, model, segs) if hasattr(mod, "not_following") else None
     if why:
-        return reject(reason=why)
+        return _loop_channel(mod, fit, val, model, can_sim, (chi2, p), why)
     theta = mod.fit_behaviour(fit, model, segs)[0] if can_sim else mod.fit_quasistatic(kf, model, segs)
     why = mod.at_bound(theta, fit, model) if hasattr(mod, "at_bound") else None
     if why:
@@ -829,3 +840,29 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, {k: None for k in pars},
                   dict(metric=metric, nominal=before, extended=after), {}, np.asarray(theta),
                   family=getattr(mod, "FAMILY", mod.NAME)), None, ext)
+
+
+def _loop_channel(mod, fit, val, model, can_sim, test, why):
+    """A stick-channel cause's loop evidence (:func:`~hunting.diagnose.causes.presliding.loop_evidence`)
+    where its creep evidence failed with reason ``why`` (test: its (chi2, p), or None where too
+    few samples stick to form it). Returns what :func:`_stick_channel` returns: the creep verdict
+    stands where the loop cannot be re-simulated (no controller or reference) or the cause has
+    no loop evidence, and a rejection states both reasons."""
+    chi2, p = test if test is not None else (None, None)
+    if not (can_sim and hasattr(mod, "loop_evidence")):
+        if test is None:
+            return None, None, model
+        return None, dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=None, reason=why), model
+    v = mod.loop_evidence(fit, val, model)
+    if "reason" in v:
+        gain = (1 - v["val"][1] / v["val"][0]) if "val" in v else None
+        return None, dict(name=mod.NAME, step="loop", statistic=chi2, p_value=p, validation_gain=gain,
+                          reason=f"{why}; and {v['reason']}"), model
+    theta = v["theta"]
+    before, after = v["val"]
+    pars = mod.parameters(theta, {}, model)
+    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, 1 - v["fit"][1] / v["fit"][0], None, pars,
+                  {k: None for k in pars},
+                  dict(metric="re-simulated position RMS error [m], validation", nominal=before, extended=after,
+                       evidence=v["evidence"]), {}, np.asarray(theta), family=getattr(mod, "FAMILY", mod.NAME)),
+            None, mod.extend(model, theta, {}))
