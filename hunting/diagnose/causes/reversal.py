@@ -95,7 +95,7 @@ REST_GUARD = 0.005  # [s] the end of a rest left out of its force: the motion th
 
 def rest_force(kin, model) -> np.ndarray:
     """The force [N] (n,) friction carries in each rest of at least REST (NaN elsewhere). At rest
-    a = 0, so it is the drive less the offset and the cogging force, taken as a running median
+    a = 0, so it is the drive less the offset and the cogging force, taken as a trailing median
     over REST (the drive of a digital loop at rest jumps by the controller's stiffness times a
     count from sample to sample: 7 N on the synthetic LuGre loop of the tests, whose bristles
     carried a steady 18 N). It is read from the rest's second half up to REST_GUARD before its
@@ -106,7 +106,6 @@ def rest_force(kin, model) -> np.ndarray:
     reporting13 d0449 a rest's median, -0.53 N, against -2.0 N at its end, made a build-up of
     1.3 N after it that the data do not have). Shorter sticks are turnarounds the position reads
     as a stick, which the bristles pass through integrated (their drive is mostly inertia)."""
-    from scipy.ndimage import median_filter
     from ..behaviour import stick_phases
     hit = _REST_CACHE.get(id(kin))
     if hit is not None and hit[0] is kin and hit[1] is model:
@@ -122,7 +121,7 @@ def rest_force(kin, model) -> np.ndarray:
     for a, b in stick_phases(kin.q, kin.dt, band, window=REST):     # the rest [a, b]
         lo = a + (b - a) // 2
         hi = max(b + 1 - guard, lo + 1)
-        part = median_filter(F[lo:hi], size=min(span, hi - lo), mode="nearest")
+        part = _trailing_median(F[lo:hi], span)
         out[a:lo] = part[0]
         out[lo:hi] = part
         out[hi:b + 1] = part[-1]
@@ -130,6 +129,19 @@ def rest_force(kin, model) -> np.ndarray:
     if len(_REST_CACHE) >= 8:
         _REST_CACHE.clear()
     _REST_CACHE[id(kin)] = (kin, model, out)
+    return out
+
+
+def _trailing_median(x: np.ndarray, span: int) -> np.ndarray:
+    """The median of x (m,) over the ``span`` samples up to each one (the first full window's
+    before it; all of x when it is shorter): at a rest's end, the median of its last ``span``
+    samples, not one padded with the last sample (a centred filter at the edge is mostly that
+    sample, a count's jump of the drive included)."""
+    from numpy.lib.stride_tricks import sliding_window_view
+    L = min(span, x.size)
+    out = np.empty(x.size)
+    out[L - 1:] = np.median(sliding_window_view(x, L), axis=1)
+    out[:L - 1] = out[L - 1]
     return out
 
 
