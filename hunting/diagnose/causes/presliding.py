@@ -182,12 +182,15 @@ def at_bound(theta, meas, model) -> str | None:
     return None
 
 
-def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0) -> tuple[np.ndarray, float]:
+def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0,
+                  above: float | None = None) -> tuple[np.ndarray, float]:
     """theta = [1 / sigma0] minimizing the error of the re-simulated LuGre loop on ``meas``: the
     creep error (:func:`creep_error`) in the stick segments ``segs``, or the whole record's
     position RMS error when ``segs`` is None (the loop evidence, :func:`loop_evidence`). A grid
     of log10 sigma0 from 1e3 N/m to :func:`stiffest` every ``step`` decades, then golden section
-    around its best point, bounded by max_evals re-simulations. Returns (theta, the RMS error
+    around its best point, bounded by max_evals re-simulations; when ``above`` [N/m] is given and
+    that bracket lies wholly above it, the grid's best point is returned unrefined (a caller that
+    rejects every sigma0 above ``above`` needs no better one). Returns (theta, the RMS error
     [m])."""
     from ..resimulate import resimulate
     cache = {}
@@ -206,6 +209,8 @@ def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0) 
     grid = np.linspace(3.0, top, max(3, int(round((top - 3.0) / step)) + 1))
     k = int(np.argmin([cost(g) for g in grid]))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    if above is not None and a > np.log10(above):
+        return np.array([10.0 ** -grid[k]]), cache[grid[k]]
     gr = (np.sqrt(5) - 1) / 2
     c, d = b - gr * (b - a), a + gr * (b - a)
     while len(cache) < max_evals and b - a > 0.01:
@@ -251,13 +256,14 @@ def loop_evidence(fit, val, model) -> dict:
     evidence fails."""
     from ..resimulate import position_rms_error
     f0 = position_rms_error(fit, model)
-    theta, f1 = fit_behaviour(fit, model, None, max_evals=LOOP_EVALS, step=LOOP_STEP)
+    bound = stiffest(model, fit) / (2.0 * LOOP_STEPS)
+    theta, f1 = fit_behaviour(fit, model, None, max_evals=LOOP_EVALS, step=LOOP_STEP, above=bound)
     out = dict(theta=theta, fit=(f0, f1))
     gain_f = 1.0 - f1 / f0 if np.isfinite(f0) and f0 > 0 else -np.inf
-    sigma0, top = 1.0 / theta[0], stiffest(model, fit)
-    if sigma0 > top / (2.0 * LOOP_STEPS):
+    sigma0 = 1.0 / theta[0]
+    if sigma0 > bound:
         return dict(out, reason=(f"the loop's best bristles (sigma0 = {sigma0:.3g} N/m) build up over less than "
-                                 f"{LOOP_STEPS:g} sensor steps (sigma0 above {top / (2.0 * LOOP_STEPS):.3g} N/m)"))
+                                 f"{LOOP_STEPS:g} sensor steps (sigma0 above {bound:.3g} N/m)"))
     if gain_f < LOOP_GAIN:
         return dict(out, reason=(f"LuGre bristles cut the fitting record's re-simulated position error by {gain_f:.1%} "
                                  f"(at sigma0 = {sigma0:.3g} N/m; {LOOP_GAIN:.0%} needed)"))
