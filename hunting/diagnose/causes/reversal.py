@@ -94,18 +94,13 @@ REST_GUARD = 0.005  # [s] the end of a rest left out of its force: the motion th
 
 
 def rest_force(kin, model) -> np.ndarray:
-    """The force [N] (n,) friction carries in each rest of at least REST (NaN elsewhere). At rest
-    a = 0, so it is the drive less the offset and the cogging force, taken as a trailing median
-    over REST (the drive of a digital loop at rest jumps by the controller's stiffness times a
-    count from sample to sample: 7 N on the synthetic LuGre loop of the tests, whose bristles
-    carried a steady 18 N). It is read from the rest's second half up to REST_GUARD before its
-    end (before the position leaves its count the mass already accelerates), held at its first
-    value before and at its last value after. It follows the force through the rest: an
-    integrator that loads a resting contact makes stiff bristles creep with it, and the motion
-    after the rest starts from the deflection at its end, not from the rest's typical one (on
-    reporting13 d0449 a rest's median, -0.53 N, against -2.0 N at its end, made a build-up of
-    1.3 N after it that the data do not have). Shorter sticks are turnarounds the position reads
-    as a stick, which the bristles pass through integrated (their drive is mostly inertia)."""
+    """The force [N] (n,) friction carries in each rest of at least REST (NaN elsewhere): the
+    median of the drive less the offset and the cogging force (at rest a = 0) over the rest's
+    second half up to REST_GUARD before its end. The drive of a digital loop at rest jumps by
+    the controller's stiffness times a count from sample to sample (7 N on the synthetic LuGre
+    loop of the tests, whose bristles carried a steady 18 N), and before the position leaves its
+    count the mass already accelerates. Shorter sticks are turnarounds the position reads as a
+    stick, which the bristles pass through integrated (their drive is mostly inertia)."""
     from ..behaviour import stick_phases
     hit = _REST_CACHE.get(id(kin))
     if hit is not None and hit[0] is kin and hit[1] is model:
@@ -113,35 +108,17 @@ def rest_force(kin, model) -> np.ndarray:
     out = np.full(kin.t.size, np.nan)
     F = kin.delayed_drive(model.delay) - model.offset - model.cogging_force(kin.q)
     guard = int(round(REST_GUARD / kin.dt))
-    span = max(3, int(round(REST / kin.dt)) | 1)
     # rests read as dwell's are (two counts, or the sensor's noise band): the samples' own stick
     # label splits a rest wherever noise moves the position by a count (463 pieces of at most
     # 13 ms on reporting8 d0477 at 5 kHz, none long enough to count)
     band = max(kin.resolution, 1e-15) + 4.0 * kin.noise
     for a, b in stick_phases(kin.q, kin.dt, band, window=REST):     # the rest [a, b]
         lo = a + (b - a) // 2
-        hi = max(b + 1 - guard, lo + 1)
-        part = _trailing_median(F[lo:hi], span)
-        out[a:lo] = part[0]
-        out[lo:hi] = part
-        out[hi:b + 1] = part[-1]
+        out[a:b + 1] = float(np.median(F[lo:max(b + 1 - guard, lo + 1)]))
     out.setflags(write=False)
     if len(_REST_CACHE) >= 8:
         _REST_CACHE.clear()
     _REST_CACHE[id(kin)] = (kin, model, out)
-    return out
-
-
-def _trailing_median(x: np.ndarray, span: int) -> np.ndarray:
-    """The median of x (m,) over the ``span`` samples up to each one (the first full window's
-    before it; all of x when it is shorter): at a rest's end, the median of its last ``span``
-    samples, not one padded with the last sample (a centred filter at the edge is mostly that
-    sample, a count's jump of the drive included)."""
-    from numpy.lib.stride_tricks import sliding_window_view
-    L = min(span, x.size)
-    out = np.empty(x.size)
-    out[L - 1:] = np.median(sliding_window_view(x, L), axis=1)
-    out[:L - 1] = out[L - 1]
     return out
 
 
