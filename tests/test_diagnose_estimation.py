@@ -200,6 +200,8 @@ def test_stiff_bristles_without_creep_are_found_by_the_loop():
     assert c.parameters["sigma0"] == pytest.approx(truth["effects"][0]["params"]["sigma0"], rel=0.05)
     assert c.p_value is None and "re-simulated with LuGre bristles" in c.gain["evidence"]
     assert 1 - c.gain["extended"] / c.gain["nominal"] >= presliding.LOOP_GAIN
+    from hunting.diagnose.report import finding
+    assert "no creep shows at rest" in finding(d, c)      # not "the mass creeps where the model holds it still"
 
 
 def test_loop_evidence_below_its_bar_reports_nothing():

@@ -26,6 +26,8 @@ def finding(dg: Diagnosis, cause) -> str:
     mod = CAUSES[cause.name]
     base = dg.model
     try:
+        if cause.hyper.get("evidence") == "loop" and hasattr(mod, "loop_sentence"):
+            return mod.loop_sentence(cause.parameters, base)
         return mod.sentence(cause.parameters, cause.increments, base)
     except (KeyError, ZeroDivisionError, TypeError, ValueError):
         return mod.DESCRIPTION

@@ -864,5 +864,6 @@ def _loop_channel(mod, fit, val, model, can_sim, test, why):
     return (Cause(mod.NAME, before / max(after, 1e-300) - 1, 1 - v["fit"][1] / v["fit"][0], None, pars,
                   {k: None for k in pars},
                   dict(metric="re-simulated position RMS error [m], validation", nominal=before, extended=after,
-                       evidence=v["evidence"]), {}, np.asarray(theta), family=getattr(mod, "FAMILY", mod.NAME)),
+                       evidence=v["evidence"]), {"evidence": "loop"}, np.asarray(theta),
+                  family=getattr(mod, "FAMILY", mod.NAME)),
             None, mod.extend(model, theta, {}))

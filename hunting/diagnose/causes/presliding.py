@@ -312,6 +312,15 @@ def extend(model, theta, hyper):
     return model.replace(law="lugre", sigma0=p["sigma0"], sigma1=p["sigma1"])
 
 
+def loop_sentence(p, model) -> str:
+    """The finding of the loop evidence (:func:`loop_evidence`): no creep shows at rest, so the
+    sentence says what the bristles do where the loop turns and stops."""
+    Fs = max(model.curve.positive.Fs, model.curve.negative.Fs)
+    return (f"after each stop and reversal friction builds up over a slip of about {_q(Fs / p['sigma0'], None, 'm')} "
+            f"instead of jumping, which changes how the loop turns and stops (LuGre bristles, "
+            f"sigma0 = {_q(p['sigma0'], None, 'N/m')}; no creep shows at rest)")
+
+
 def sentence(p, inc, model) -> str:
     return (f"the mass creeps where the model holds it still: the contact is a spring of "
             f"{_q(p['sigma0'], None, 'N/m')} below the break-away force (LuGre bristles)")
