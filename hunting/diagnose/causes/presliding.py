@@ -192,18 +192,17 @@ def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0,
     that bracket lies wholly above it, the grid's best point is returned unrefined (a caller that
     rejects every sigma0 above ``above`` needs no better one). Returns (theta, the RMS error
     [m])."""
-    from ..resimulate import resimulate
+    from ..resimulate import position_rms_error, resimulate
     cache = {}
 
     def cost(lg):
         if lg not in cache:
-            sim = resimulate(meas, extend(model, np.array([10.0 ** -lg]), {}))
-            if not sim.ok:
-                cache[lg] = np.inf
-            elif segs is None:
-                cache[lg] = float(np.sqrt(np.mean((sim.q - meas.q[:sim.q.size]) ** 2)))
+            ext = extend(model, np.array([10.0 ** -lg]), {})
+            if segs is None:
+                cache[lg] = position_rms_error(meas, ext)
             else:
-                cache[lg] = creep_error(sim.q, meas.q, segs)
+                sim = resimulate(meas, ext)
+                cache[lg] = creep_error(sim.q, meas.q, segs) if sim.ok else np.inf
         return cache[lg]
     top = max(np.log10(stiffest(model, meas)), 4.0)
     grid = np.linspace(3.0, top, max(3, int(round((top - 3.0) / step)) + 1))
