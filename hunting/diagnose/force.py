@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .causes import CAUSES, hyper_keys, untestable
+from .causes import CAUSES, hyper_count, hyper_keys, untestable
 from .kinematics import Kinematics, residual
 from .model import NominalModel
 from .stats import NoiseModel, Samples, out_of_sample
@@ -173,6 +173,8 @@ class Library:
         j = int(np.argmin(fits))
         start = self.variants[name][j].hyper
         keys = hyper_keys(name, start)
+        if not keys:                   # a variant at fixed hyper-parameters: nothing to move
+            return None
         shift = getattr(mod, "shift", None)
 
         def at(x):
@@ -294,7 +296,7 @@ class Library:
         else:
             theta, rss = np.zeros(0), float(yy)
         rss = max(rss, 1e-300 * max(yy, 1.0))
-        hyp = sum(CAUSES[n].HYPERS for n, _ in members)
+        hyp = sum(hyper_count(n, self.variants[n][j].hyper) for n, j in members)
         bic = self.m * np.log(rss / self.m) + (len(cols) + hyp) * np.log(self.m)
         why = unphysical_members(self, members, theta)
         if len(members) > 1:
@@ -344,11 +346,13 @@ class Library:
                 if self.n_indexed[n] == 1:
                     continue
                 fits = [self.fit([(m, (j if m == n else cur[m])) for m in names]) for j in range(self.n_indexed[n])]
-                ok = [f.rss if f.physical else np.inf for f in fits]
+                # by BIC: variants of one cause with as many coefficients and hyper-parameters
+                # rank as by their fit (ties within 1e-6 of it to the first); fewer pay less
+                ok = [f.bic if f.physical else np.inf for f in fits]
                 lo = min(ok)
                 if not np.isfinite(lo):
                     continue                   # no variant is physical: keep the current one
-                j = next(j for j, f in enumerate(ok) if f <= lo * (1 + 1e-6) + 1e-300)
+                j = next(j for j, f in enumerate(ok) if f <= lo + self.m * 1e-6)
                 changed |= j != cur[n]
                 cur[n] = j
             if not changed:

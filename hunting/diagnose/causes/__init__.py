@@ -8,7 +8,8 @@ NominalModel (what the behaviour view re-simulates); optionally ``unphysical(the
 returning why a fitted theta is not the physical effect (the cause is then rejected), else None;
 optionally ``shift(kin, model, hyper)``: the known, unfitted part (n,) [N] of the extension's
 force change (e.g. the nominal Stribeck dip moved to a new vs). Also: ``FAMILY`` (causes that share
-a signature share it), ``HYPERS`` (continuous hyper-parameters searched, counted in BIC),
+a signature share it), ``HYPERS`` (continuous hyper-parameters searched, counted in BIC; optionally ``hyper_count(hyper)``
+where a variant searched fewer: :func:`hyper_count`),
 ``HYPER_KEYS`` (those refined by Gauss-Newton; optionally ``hyper_keys(hyper)`` giving those a
 variant has, when some do not apply to it: :func:`hyper_keys`; ``derived_sigma(parameters, sigma)``
 giving the standard uncertainty of parameters computed from them, and ``refine_starts(hyper)``:
@@ -44,6 +45,15 @@ def hyper_keys(name: str, hyper: dict) -> tuple:
     return tuple(fn(hyper)) if fn is not None else tuple(getattr(mod, "HYPER_KEYS", ()))
 
 
+def hyper_count(name: str, hyper: dict) -> int:
+    """The hyper-parameters a variant of cause ``name`` searched, counted in BIC: its
+    ``hyper_count(hyper)`` where it has one (a variant at fixed hyper-parameters searched none),
+    else its ``HYPERS``."""
+    mod = CAUSES[name]
+    fn = getattr(mod, "hyper_count", None)
+    return int(fn(hyper)) if fn is not None else int(mod.HYPERS)
+
+
 def untestable(name: str, kin, model) -> str | None:
     """Why a record (its Kinematics) cannot test cause ``name`` against ``model`` (its
     ``untestable`` hook), or None when it can or the cause has no such hook."""
@@ -51,4 +61,4 @@ def untestable(name: str, kin, model) -> str | None:
     return fn(kin, model) if fn is not None else None
 
 
-__all__ = ["CAUSES", "hyper_keys", "untestable"]
+__all__ = ["CAUSES", "hyper_count", "hyper_keys", "untestable"]

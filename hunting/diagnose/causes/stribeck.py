@@ -8,7 +8,16 @@ invented offset and asymmetry on 7 of that draw's 12 new dips), and beta the nom
 its shape and was fitted better by a level and a viscous change than by the Gaussian one,
 reporting8 d0485). The change against the nominal curve is c1 sign(v) + c2 sign(v)
 exp(-(|v|/vs)^beta) (fitted) plus the known move of the nominal dip Fs - Fc from its shape to
-the new one (``shift``)."""
+the new one (``shift``).
+
+One variant more holds the nominal shape and Coulomb level and fits the static level alone
+(``dip``: c2 at the model's own vs and beta, no hyper-parameter searched): the commonest Stribeck
+error, and the only one a record whose speeds barely reach the dip can pin down. With c1 free, such
+a record traded c1 against c2 (reporting15 d0443, a static level 0.76 -> 0.68 N at the nominal
+shape: c1 = -0.42 N, c2 = +0.95 N at vs 9.4 mm/s, fitting the record and predicting the validation
+record 110 times worse than the nominal; d0471, d0513 alike). The search picks between variants by
+BIC (:meth:`hunting.diagnose.force.Library.best_variants`), so the two-coefficient variants win
+only where their freedom pays."""
 from dataclasses import replace
 
 import numpy as np
@@ -46,16 +55,38 @@ def hypers(kin, model) -> list:
     v = kin.v[kin.moving]
     if min(np.mean(v > 0), np.mean(v < 0)) < ONE_WAY:
         # the other direction's velocity is not in these data: the dip is taken symmetric
-        return [{"vs": vs, "vs_neg": vs, "tied": True} for vs in sorted(grid)]
-    return [{"vs": vs, "vs_neg": vs * r} for vs in sorted(grid) for r in RATIOS]
+        out = [{"vs": vs, "vs_neg": vs, "tied": True} for vs in sorted(grid)]
+    else:
+        out = [{"vs": vs, "vs_neg": vs * r} for vs in sorted(grid) for r in RATIOS]
+    pos, neg = model.curve.positive, model.curve.negative
+    if pos.Fs != pos.Fc and neg.Fs != neg.Fc:
+        out.append({"vs": float(pos.vs), "vs_neg": float(neg.vs), "dip": True})
+    return out
 
 
 ONE_WAY = 0.1     # a record with less than this share of its sliding samples one way slides the other way only
 
 
 def hyper_keys(hyper) -> tuple:
-    """The refined hyper-parameters of a variant: vs alone where the dip is ``tied``."""
+    """The refined hyper-parameters of a variant: vs alone where the dip is ``tied``, none for the
+    static level alone (``dip``: the nominal shape)."""
+    if hyper.get("dip"):
+        return ()
     return ("vs",) if hyper.get("tied") else HYPER_KEYS
+
+
+def hyper_count(hyper) -> int:
+    """The hyper-parameters a variant searched (counted in BIC): none for the static level alone
+    at the nominal shape (``dip``), HYPERS for the others."""
+    return 0 if hyper.get("dip") else HYPERS
+
+
+def _coefficients(theta, hyper) -> tuple[float, float]:
+    """(c1, c2) [N]: the Coulomb level's change and the dip's; the static level alone (``dip``)
+    fits c2 only."""
+    if hyper.get("dip"):
+        return 0.0, float(theta[0])
+    return float(theta[0]), float(theta[1])
 
 
 def _vs_neg(hyper) -> float:
@@ -75,7 +106,8 @@ def design(kin, model, hyper):
     s = np.sign(v)
     beta = np.where(v > 0, exponent(model.curve.positive), exponent(model.curve.negative))
     vs = np.where(v > 0, hyper["vs"], _vs_neg(hyper))
-    return kin.sliding(np.column_stack([s, s * np.exp(-(np.abs(v) / vs) ** beta)]))
+    dip = s * np.exp(-(np.abs(v) / vs) ** beta)
+    return kin.sliding(dip[:, None] if hyper.get("dip") else np.column_stack([s, dip]))
 
 
 def shift(kin, model, hyper) -> np.ndarray:
@@ -92,29 +124,33 @@ def shift(kin, model, hyper) -> np.ndarray:
 
 
 def unphysical(theta, hyper, model) -> str | None:
+    c1, c2 = _coefficients(theta, hyper)
     dip = min(model.curve.positive.Fs - model.curve.positive.Fc, model.curve.negative.Fs - model.curve.negative.Fc)
-    Fc = min(model.curve.positive.Fc, model.curve.negative.Fc) + float(theta[0])
+    Fc = min(model.curve.positive.Fc, model.curve.negative.Fc) + c1
     if Fc < 0:
         return f"Fc = {Fc:.3g} N < 0"
-    if dip + theta[1] < 0:
-        return (f"Fs - Fc = {dip + theta[1]:.3g} N < 0 (friction rising with speed at low speed); a force dip at "
+    if dip + c2 < 0:
+        return (f"Fs - Fc = {dip + c2:.3g} N < 0 (friction rising with speed at low speed); a force dip at "
                 "low speed through reversals is frictional memory (lag) or presliding, not a Stribeck curve")
     return None
 
 
 def parameters(theta, hyper, model) -> dict:
     c = model.curve.positive
-    Fc = float(c.Fc + theta[0])
-    return {"Fc": Fc, "Fs": float(Fc + c.Fs - c.Fc + theta[1]), "vs": hyper["vs"], "vs_neg": _vs_neg(hyper)}
+    c1, c2 = _coefficients(theta, hyper)
+    Fc = float(c.Fc + c1)
+    return {"Fc": Fc, "Fs": float(Fc + c.Fs - c.Fc + c2), "vs": hyper["vs"], "vs_neg": _vs_neg(hyper)}
 
 
 def extend(model, theta, hyper):
-    """Levels Fc + theta0 and Fs - Fc grown by theta1, at the fitted vs with the exponent of
-    :func:`exponent`."""
+    """Levels Fc + c1 and Fs - Fc grown by c2 (:func:`_coefficients`), at the fitted vs with the
+    exponent of :func:`exponent`."""
+    c1, c2 = _coefficients(theta, hyper)
+
     def new(vs):
         def curve(c):
-            Fc = max(c.Fc + float(theta[0]), 0.0)
-            return replace(c, Fc=Fc, Fs=Fc + (c.Fs - c.Fc) + float(theta[1]), vs=vs, beta=exponent(c))
+            Fc = max(c.Fc + c1, 0.0)
+            return replace(c, Fc=Fc, Fs=Fc + (c.Fs - c.Fc) + c2, vs=vs, beta=exponent(c))
         return curve
     out = with_curves(model, new(hyper["vs"]), new(_vs_neg(hyper)))
     return out.replace(law="stribeck") if model.law == "coulomb-viscous" else out
