@@ -53,11 +53,15 @@ LEVEL_RATIO = 3.0      # each rest's excess over its reading's error scale, for 
 LEVEL_FLOOR = 0.02     # of Fs: the smallest error scale of a break-away reading
 
 
-def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def rests(meas, model, resolution: float, level: np.ndarray | None = None
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(t_rest [s], F [N], s, scale [N]) per rest that ends in motion: its duration up to the
     break-away, the force friction carried there, the direction of the motion that follows
     (+1 / -1) and how much the force ramps between that reading and the first sample that left
-    the rest (the reading's uncertainty, and the scale of its error: a covariate of the test)."""
+    the rest (the reading's uncertainty, and the scale of its error: a covariate of the test).
+    ``level`` (n,) [N]: the sliding friction right after a break-away at each sample where the
+    model's frictional memory makes it differ from Fs (:func:`level_after_break_away`); None:
+    Fs."""
     from ..behaviour import stick_phases
     dt = meas.dt
     # a count, or the sensor's noise band where that is wider (noise would fake moves and rests)
@@ -105,13 +109,20 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
         # the ramp alone a grown break-away force was read low)
         toward = max(s_k * slope, 0.0) / dt          # [N/s] the ramp toward the motion
         Fs_dir = (model.curve.positive if s_k > 0 else model.curve.negative).Fs
+        # what slows the mass once it breaks away: Fs, or the lagging level where the model has
+        # frictional memory (after a short rest it has not relaxed back to Fs, so the mass leaves
+        # sooner than Fs would let it: read as with Fs, short rests read low and a lag looks like
+        # a dwell effect; reporting15 d0490, a 85 ms lag, gave level -0.59 N, gain 0.47 N, 57 ms)
+        # (the force on the mass at its break-away is at least Fs, so its net force then at
+        # least Fs less that level: the passes start there)
+        slows = Fs_dir if level is None else min(float(level[k_end]), Fs_dir)
         x_end = n_fit - 1.0
         x_min = -float(min(k_end - n_fit + 1 - a, 3 * n_fit))     # within the rest: the line extrapolated
-        drop = 0.0
+        drop = Fs_dir - slows
         for _ in range(DEPARTURE_PASSES):
             D = departure_time(0.75 * resolution, model.mass, drop, toward)
             x_b = min(max(x_end + 0.5 - D / dt, x_min), x_end)
-            drop = max(s_k * float(icpt + slope * x_b) - Fs_dir, 0.0)
+            drop = max(s_k * float(icpt + slope * x_b), Fs_dir) - slows
         held = (k_end - n_fit + 1 + x_b - a + 0.5) * dt
         if held < REST_WINDOW:
             # the break-away reads less than a rest window into the rest: the contact crept within
@@ -126,6 +137,16 @@ def rests(meas, model, resolution: float) -> tuple[np.ndarray, np.ndarray, np.nd
         tr.append(held)
         rp.append(abs(float(slope)) * (x_end - x_b + 1.0))
     return np.array(tr), np.array(Fb), np.array(sd), np.array(rp)
+
+
+def level_after_break_away(kin, model) -> np.ndarray | None:
+    """The sliding friction level [N] (n,) the mass meets right after a break-away at each sample
+    of the record (its Kinematics ``kin``) under the model's frictional memory: the lagging
+    Stribeck level, which relaxes towards Fs while the mass rests
+    (:meth:`~hunting.diagnose.model.NominalModel.lagged_level`). None without memory (Fs)."""
+    if not model.lag > 0:
+        return None
+    return model.lagged_level(kin.vf, kin.slide, kin.dt, model.lag)
 
 
 def departure_time(distance: float, mass: float, drop: float, ramp: float) -> float:
@@ -297,8 +318,10 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     sigma, metric, nominal, extended, model (the extended model) or reason (why not); with
     ``otherwise``, the verdict of the break-away level (:func:`level_verdict`) where every rest
     shows one, judged when the growth test fails."""
-    t, F, s, scale = rests(fit, model, resolution)
-    tv, Fv, sv, scale_v = rests(validate, model, resolution)
+    lf, lv = ((level_after_break_away(k, model) if k is not None and k.t.size == m.n else None)
+              for k, m in ((kf, fit), (kv, validate)))
+    t, F, s, scale = rests(fit, model, resolution, lf)
+    tv, Fv, sv, scale_v = rests(validate, model, resolution, lv)
     out = _growth_verdict(t, F, s, scale, tv, Fv, sv, scale_v, model)
     level = level_verdict(np.concatenate([t, tv]), np.concatenate([F, Fv]), np.concatenate([s, sv]),
                           np.concatenate([scale, scale_v]), model)
