@@ -252,12 +252,13 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
                    f"validation data, fewer than {MIN_WINDOWS}: the smoothed residual has about that many independent "
                    "values")
             notes.append(f"force channel skipped: {why}")
-            untested += [dict(name=n, reason=why) for n in force_names]
         fc = dict(causes=[], nominal=None, extended=None, rejected=[], alternatives=[], explanations=[], model=model,
                   r_fit=nan_f, r_val_nom=nan_v, r_val_ext=nan_v)
+        if force_names:
+            fc.update(_loop_force_channel(fit, validate, model, force_names, why, untested))
     ext = fc["model"]
     result, rejected = list(fc["causes"]), list(fc["rejected"])
-    can_sim = model.controller is not None and validate.q_ref is not None and fit.q_ref is not None
+    can_sim = _can_simulate(fit, validate, model)
     for name in stick_names:
         tick(name)
         if ext.law == "lugre" and model.law != "lugre":
@@ -311,6 +312,54 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     return Diagnosis(result, fc["nominal"], fc["extended"], crit, model, kf, kv, fc["r_fit"], fc["r_val_nom"],
                      fc["r_val_ext"], rejected, fc["alternatives"], ext, view, notes, validate, sims, untested,
                      fc["explanations"])
+
+
+def _can_simulate(fit: Measurement, validate: Measurement, model: NominalModel) -> bool:
+    """Whether both records' loops can be re-simulated: the model has a controller and both
+    records their reference."""
+    return model.controller is not None and validate.q_ref is not None and fit.q_ref is not None
+
+
+def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalModel, names, why: str,
+                        untested: list) -> dict:
+    """The force channel's part of the result where it was skipped for ``why`` (too few sliding
+    samples): the force-channel causes ``names`` judged on the re-simulated loop
+    (:func:`hunting.diagnose.loop_channel.judge`) where the loop can be re-simulated; the others go
+    to ``untested``. Returns the fields of the force channel's result it sets (causes, model,
+    rejected, alternatives)."""
+    from . import loop_channel
+    if not _can_simulate(fit, validate, model):
+        untested += [dict(name=n, reason=why) for n in names]
+        return {}
+    v = loop_channel.judge(fit, validate, model, names)
+    tried = {r["name"] for r in v["rejected"]} | {r["name"] for r in [v["cause"], *v["alternatives"]] if r}
+    untested += [dict(name=n, reason=why) for n in names if n not in tried]
+    out = dict(rejected=[dict(name=r["name"], step="loop", statistic=None, p_value=None, validation_gain=None,
+                              reason=f"{why}; and {r['reason']}") for r in v["rejected"]])
+    metric = "re-simulated position RMS error [m], validation"
+
+    def parameters(r):
+        mod = CAUSES[r["name"]]
+        pars = mod.parameters(np.array([r["x"]]), {}, model)
+        base = mod.parameters(np.zeros(1), {}, model)
+        return pars, {k: float(pars[k] - base[k]) for k in pars}
+    out["alternatives"] = [dict(name=r["name"], kind="loop", parameters=parameters(r)[0],
+                                gain=dict(metric=metric + ", in place of " + v["cause"]["name"], nominal=r["val"][0],
+                                          extended=r["val"][1]))
+                           for r in v["alternatives"]]
+    r = v["cause"]
+    if r is None:
+        out["causes"] = []
+        return out
+    mod = CAUSES[r["name"]]
+    pars, inc = parameters(r)
+    (before, after) = r["val"]
+    out["causes"] = [Cause(r["name"], before / max(after, 1e-300) - 1, r["gain_fit"], None, pars,
+                           {k: None for k in pars},
+                           dict(metric=metric, nominal=before, extended=after, evidence=loop_channel.evidence_text(r)),
+                           {"evidence": "loop"}, np.array([r["x"]]), inc, getattr(mod, "FAMILY", mod.NAME))]
+    out["model"] = loop_channel.extended(r["name"], model, r["x"])
+    return out
 
 
 def _library_builder(fit: Measurement, validate: Measurement, kf: Kinematics, kv: Kinematics, model: NominalModel,

@@ -1,0 +1,134 @@
+"""The force-channel causes judged on the loop, where too few samples slide for the force balance.
+
+A record of a positioning loop that mostly sticks (a hunting cycle, short strokes) leaves the
+force channel fewer than 100 usable sliding samples, and it is skipped. Its causes still change
+how the loop moves: a static level that is 30 % off changes every stick-slip cycle, a delay
+every overshoot. Here each candidate's one parameter is fitted on the fitting record's
+re-simulated loop (whole-record position RMS error, :func:`fit_one`), the candidate that cuts
+that error most is taken, and it is named when it cuts the error by at least
+:data:`~hunting.diagnose.causes.presliding.LOOP_GAIN` on both records (presliding's loop evidence,
+the same bar). Candidates that pass the bar too are listed as alternatives; a candidate chosen
+by its validation gain would not be out of sample.
+
+Calibration (development sets reporting14 and reporting15, 31 clean records with a controller
+whose force channel was skipped): the best candidate's smaller gain of the two records was at most
+0.26 (level on reporting15 d0094: 0.71 fitting, 0.26 validation); true causes on such records
+reached 0.59-0.94 (offset r14 d0314; level r15 d0439, d0495; delay r15 d0376). The evidence is
+not a p-value: a stick-slip loop's position error is not a sum of independent terms."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SystemDefinitionError
+from .causes import CAUSES
+from .causes.presliding import LOOP_GAIN
+from .data import Measurement
+from .model import NominalModel
+
+GRID = 7             # the grid of each candidate's parameter over its span
+REFINE = 5           # bounded Brent evaluations around the grid's best point
+MAX_DELAY = 0.02     # [s] the largest delay tried
+
+
+def spans(model: NominalModel, meas: Measurement) -> dict:
+    """{cause: (lo, hi)}: the range of each candidate's one coefficient (the increment its
+    ``extend`` takes), from the model and the fitting record ``meas``. offset: +-Fs; level: a
+    factor 1/3..3 on Fc and Fs; viscous: from no viscous friction to 3 times the larger of the
+    model's b and the b that doubles Fs at the record's typical speed (90th percentile); mass:
+    a factor 0.4..3; delay: 0..MAX_DELAY [s] beyond the model's; lag: 0..0.3 s beyond the
+    model's, where the curve has a Stribeck dip to lag."""
+    pos, neg = model.curve.positive, model.curve.negative
+    Fs = max(pos.Fs, neg.Fs)
+    speed = np.abs(np.diff(meas.q)) / meas.dt
+    v90 = float(np.percentile(speed[speed > 0], 90)) if np.any(speed > 0) else 0.0
+    b = min(pos.b, neg.b)
+    b_ref = max(pos.b, neg.b, Fs / v90 if v90 > 0 else 0.0)
+    out = {"mass": (-0.6 * model.mass, 2.0 * model.mass), "delay": (0.0, MAX_DELAY)}
+    if Fs > 0:
+        out.update(offset=(-Fs, Fs), level=(-2.0 / 3.0, 2.0))
+    if b_ref > 0:
+        out["viscous"] = (-b, 3.0 * b_ref)
+    if model.law != "lugre" and (pos.Fs > pos.Fc or neg.Fs > neg.Fc):
+        out["lag"] = (0.0, 0.3)
+    return out
+
+
+def extended(name: str, model: NominalModel, x: float) -> NominalModel | None:
+    """The model with cause ``name``'s one coefficient x (its ``extend``), None where that is not a
+    physical model."""
+    try:
+        return CAUSES[name].extend(model, np.array([float(x)]), {})
+    except SystemDefinitionError:
+        return None
+
+
+def fit_one(name: str, meas: Measurement, model: NominalModel, span: tuple) -> tuple[float, float]:
+    """(x, error): cause ``name``'s coefficient minimizing the re-simulated position RMS error [m]
+    on ``meas``: a grid of GRID points over ``span``, then bounded Brent within the best point's
+    neighbours (at most REFINE more re-simulations); error inf where no point re-simulates."""
+    from scipy.optimize import minimize_scalar
+
+    from .resimulate import position_rms_error
+    cache = {}
+
+    def cost(x):
+        x = float(x)
+        if x not in cache:
+            ext = extended(name, model, x)
+            e = position_rms_error(meas, ext) if ext is not None else np.inf
+            cache[x] = e if np.isfinite(e) else np.inf
+        return cache[x]
+    grid = np.linspace(span[0], span[1], GRID)
+    errs = [cost(g) for g in grid]
+    k = int(np.argmin(errs))
+    if not np.isfinite(errs[k]):
+        return float(grid[k]), np.inf
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, GRID - 1)]
+    minimize_scalar(lambda x: min(cost(x), 1e300), bounds=(lo, hi), method="bounded",
+                    options=dict(maxiter=REFINE, xatol=1e-4 * (span[1] - span[0])))
+    best = min(cache, key=cache.get)
+    return best, cache[best]
+
+
+def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dict:
+    """The loop channel's verdict on the force-channel causes ``names`` (those with a one-parameter
+    loop extension, :func:`spans`): ``cause`` (name, coefficient, the fitting and validation
+    position RMS errors nominal and extended) or None, ``alternatives`` (the others that pass the
+    bar, same fields), ``rejected`` (name, reason) for the candidates tried."""
+    from .resimulate import position_rms_error
+    f0, v0 = position_rms_error(fit, model), position_rms_error(val, model)
+    out = dict(cause=None, alternatives=[], rejected=[])
+    if not (np.isfinite(f0) and f0 > 0 and np.isfinite(v0) and v0 > 0):
+        out["rejected"] = [dict(name=n, reason="the nominal loop does not re-simulate these records") for n in names]
+        return out
+    tried = []
+    for name, span in spans(model, fit).items():
+        if name not in names:
+            continue
+        x, f1 = fit_one(name, fit, model, span)
+        tried.append(dict(name=name, x=x, fit=(f0, f1), gain_fit=1.0 - f1 / f0))
+    tried.sort(key=lambda r: -r["gain_fit"])
+    for r in tried:
+        ext = extended(r["name"], model, r["x"])
+        v1 = position_rms_error(val, ext) if r["gain_fit"] >= LOOP_GAIN and ext is not None else np.nan
+        r.update(val=(v0, v1), gain_val=1.0 - v1 / v0 if np.isfinite(v1) else None)
+        if r["gain_fit"] < LOOP_GAIN:
+            r["reason"] = (f"fitted on the fitting record's loop it cuts the re-simulated position error by "
+                           f"{r['gain_fit']:.1%} ({LOOP_GAIN:.0%} needed on both records)")
+        elif not (r["gain_val"] is not None and r["gain_val"] >= LOOP_GAIN):
+            g = "nothing" if r["gain_val"] is None else f"{r['gain_val']:.1%}"
+            r["reason"] = (f"fitted on the fitting record's loop ({r['gain_fit']:.1%} there) it cuts the validation "
+                           f"record's position error by {g} ({LOOP_GAIN:.0%} needed)")
+    passed = [r for r in tried if "reason" not in r]
+    if passed:
+        out["cause"], out["alternatives"] = passed[0], passed[1:]
+    out["rejected"] = [dict(name=r["name"], reason=r["reason"]) for r in tried if "reason" in r]
+    return out
+
+
+def evidence_text(r: dict) -> str:
+    """The rule a loop-channel cause met, in words (its record ``r`` from :func:`judge`)."""
+    return (f"too few sliding samples for the force balance; the loop re-simulated with it (fitted on the fitting "
+            f"record's position) follows both records better: position RMS error -{r['gain_fit']:.0%} fitting, "
+            f"-{r['gain_val']:.0%} validation (at least {LOOP_GAIN:.0%} on both needed; the best of the candidates "
+            "on the fitting record)")
