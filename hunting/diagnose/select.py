@@ -63,7 +63,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by as much, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%}; presliding, where no creep shows at rest, also "
         "when LuGre bristles fitted on the fitting record's re-simulated loop cut both records' position error by at "
-        "least {loop_gain:.0%}")
+        "least {loop_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
+        "that fitted on the fitting record's loop cuts its position error most, when it cuts both records' by at least "
+        "{loop_gain:.0%}")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
