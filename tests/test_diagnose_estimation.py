@@ -631,3 +631,36 @@ def test_a_clean_record_that_mostly_sticks_gets_nothing_from_the_loop():
     rows = [r for r in d.rejected if r.get("step") == "loop"]
     assert {r["name"] for r in rows} >= {"offset", "level", "mass", "delay"}
     assert all("50% needed" in r["reason"] for r in rows)
+
+
+def test_the_loop_channel_names_only_the_best_candidate_on_the_fitting_record(monkeypatch):
+    """The loop channel's rule on given errors: the candidate that cuts the fitting record's
+    position error most is named when it cuts both records' by LOOP_GAIN; others that pass are
+    alternatives; when the best fails on the validation record, none behind it is named (that
+    choice would be made by the validation gain)."""
+    from hunting.diagnose import loop_channel, resimulate
+    model = NominalModel.from_dict({"preset": "table9.1", "set": {"P": 20.0}})
+    t = np.arange(100) * 1e-3
+    fit, val = (Measurement(t, np.zeros(100), np.zeros(100), q_ref=np.zeros(100), name=n) for n in ("fit", "val"))
+    fitted = {"offset": 0.3, "level": 0.1, "mass": 0.45, "delay": 0.9, "viscous": 1.0, "lag": 1.0}
+
+    def changed(m):
+        if m is model:
+            return None
+        return ("offset" if m.offset != model.offset else "mass" if m.mass != model.mass
+                else "level" if m.curve != model.curve else "other")
+
+    def run(validation):
+        monkeypatch.setattr(loop_channel, "fit_one", lambda name, meas, m, span: (0.5, fitted[name]))
+        monkeypatch.setattr(resimulate, "position_rms_error",
+                            lambda meas, m: 1.0 if changed(m) is None else validation[changed(m)])
+        return loop_channel.judge(fit, val, model, list(fitted))
+    # level fits best (90 % on the fitting record); offset and mass pass too
+    v = run({"level": 0.2, "offset": 0.3, "mass": 0.4})
+    assert v["cause"]["name"] == "level" and {r["name"] for r in v["alternatives"]} == {"offset", "mass"}
+    # the best fails on the validation record: offset would pass behind it, and is not named
+    v = run({"level": 0.8, "offset": 0.3, "mass": 0.4})
+    assert v["cause"] is None and v["alternatives"] == []
+    reasons = {r["name"]: r["reason"] for r in v["rejected"]}
+    assert "level fitted the fitting record's loop better" in reasons["offset"]
+    assert "cuts the validation record's position error by 20.0%" in reasons["level"]

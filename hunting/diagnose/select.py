@@ -355,7 +355,7 @@ def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalM
         return out
     mod = CAUSES[r["name"]]
     pars, inc = parameters(r)
-    (before, after) = r["val"]
+    before, after = r["val"]
     out["causes"] = [Cause(r["name"], before / max(after, 1e-300) - 1, r["gain_fit"], None, pars,
                            {k: None for k in pars},
                            dict(metric=metric, nominal=before, extended=after, evidence=loop_channel.evidence_text(r)),
