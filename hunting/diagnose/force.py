@@ -492,7 +492,8 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             worst = min(failing, key=lambda n: tests[n]["gain"])
             rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
                                  p_value=tests[worst]["p_value"], validation_gain=tests[worst]["gain"],
-                                 reason=_why(tests[worst], alpha, min_gain, alpha_reference)))
+                                 reason=_why(tests[worst], alpha, min_gain, alpha_reference),
+                                 reference_only=reference_only(tests[worst], alpha, min_gain, alpha_reference)))
             dropped.add(worst)
             current = _physical_subset(lib, fits, tuple(n for n in current.names if n != worst), rejected)
             if not current.names:
@@ -557,6 +558,16 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                                  f"{alone.bic - fits[()].bic:+.1f} and the validation residual by {-gain:+.1%}")
     return dict(explanation=current, tests=tests if current.members else {}, rejected=list(last.values()),
                 ranking=ranking, noise_val=noise_v, fits=fits)
+
+
+def reference_only(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:
+    """Whether a member's tests (:func:`_tests`) fail the rule only along the reference trajectory
+    (a noise-fed cause significant and large enough on the measured validation data, whose
+    prediction along the noise-free loop does not hold): the loop can still judge it
+    (:func:`hunting.diagnose.select._loop_admission`)."""
+    along = ("p_reference", "gain_reference", "gain_reference_set")
+    return _fails(t, alpha, min_gain, alpha_reference) and not _fails(
+        {k: v for k, v in t.items() if k not in along}, alpha, min_gain, alpha_reference)
 
 
 def _fails(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:

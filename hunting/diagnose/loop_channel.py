@@ -137,9 +137,10 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
     return out
 
 
-def evidence_text(r: dict) -> str:
-    """The rule a loop-channel cause met, in words (its record ``r`` from :func:`judge`)."""
-    return (f"too few sliding samples for the force balance; the loop re-simulated with it (fitted on the fitting "
+def evidence_text(r: dict, why: str = "too few sliding samples for the force balance") -> str:
+    """The rule a loop-channel cause met, in words (its record ``r`` from :func:`judge`), after
+    ``why`` the loop judged it."""
+    return (f"{why}; the loop re-simulated with it (fitted on the fitting "
             f"record's position) follows both records better: position RMS error -{r['gain_fit']:.0%} fitting, "
             f"-{r['gain_val']:.0%} validation (at least {LOOP_GAIN:.0%} on both needed; the best of the candidates "
             "on the fitting record)")

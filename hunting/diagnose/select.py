@@ -258,9 +258,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
                   r_fit=nan_f, r_val_nom=nan_v, r_val_ext=nan_v)
         if force_names:
             fc.update(_loop_force_channel(fit, validate, model, force_names, why, untested))
+    can_sim = _can_simulate(fit, validate, model)
+    if can_sim and fc["nominal"] is not None:
+        fc = _loop_admission(fc, fit, validate)
     ext = fc["model"]
     result, rejected = list(fc["causes"]), list(fc["rejected"])
-    can_sim = _can_simulate(fit, validate, model)
     for name in stick_names:
         tick(name)
         if ext.law == "lugre" and model.law != "lugre":
@@ -338,29 +340,74 @@ def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalM
     untested += [dict(name=n, reason=why) for n in names if n not in tried]
     out = dict(rejected=[dict(name=r["name"], step="loop", statistic=None, p_value=None, validation_gain=None,
                               reason=f"{why}; and {r['reason']}") for r in v["rejected"]])
-    metric = "re-simulated position RMS error [m], validation"
-
-    def parameters(r):
-        mod = CAUSES[r["name"]]
-        pars = mod.parameters(np.array([r["x"]]), {}, model)
-        base = mod.parameters(np.zeros(1), {}, model)
-        return pars, {k: float(pars[k] - base[k]) for k in pars}
-    out["alternatives"] = [dict(name=r["name"], kind="loop", parameters=parameters(r)[0],
-                                gain=dict(metric=metric + ", in place of " + v["cause"]["name"], nominal=r["val"][0],
-                                          extended=r["val"][1]))
+    out["alternatives"] = [dict(name=r["name"], kind="loop", parameters=_loop_parameters(r, model)[0],
+                                gain=dict(metric=LOOP_METRIC + ", in place of " + v["cause"]["name"],
+                                          nominal=r["val"][0], extended=r["val"][1]))
                            for r in v["alternatives"]]
     r = v["cause"]
-    if r is None:
-        out["causes"] = []
-        return out
+    out["causes"] = [] if r is None else [_loop_cause(r, model, loop_channel.evidence_text(r), r["gain_fit"], None)]
+    if r is not None:
+        out["model"] = loop_channel.extended(r["name"], model, r["x"])
+    return out
+
+
+def _loop_cause(r: dict, model: NominalModel, evidence: str, statistic, p_value) -> Cause:
+    """The Cause of a loop verdict ``r`` (:func:`hunting.diagnose.loop_channel.judge`) on ``model``:
+    its parameters final values, the validation position error its gain, ``evidence`` its rule in
+    words."""
     mod = CAUSES[r["name"]]
-    pars, inc = parameters(r)
+    pars, inc = _loop_parameters(r, model)
     before, after = r["val"]
-    out["causes"] = [Cause(r["name"], before / max(after, 1e-300) - 1, r["gain_fit"], None, pars,
-                           {k: None for k in pars},
-                           dict(metric=metric, nominal=before, extended=after, evidence=loop_channel.evidence_text(r)),
-                           {"evidence": "loop"}, np.array([r["x"]]), inc, getattr(mod, "FAMILY", mod.NAME))]
-    out["model"] = loop_channel.extended(r["name"], model, r["x"])
+    return Cause(r["name"], before / max(after, 1e-300) - 1, statistic, p_value, pars, {k: None for k in pars},
+                 dict(metric=LOOP_METRIC, nominal=before, extended=after, evidence=evidence), {"evidence": "loop"},
+                 np.array([r["x"]]), inc, getattr(mod, "FAMILY", mod.NAME))
+
+
+LOOP_METRIC = "re-simulated position RMS error [m], validation"
+
+
+def _loop_parameters(r: dict, model: NominalModel) -> tuple[dict, dict]:
+    """(final parameters, increments) of a loop verdict ``r``'s one coefficient on ``model``."""
+    mod = CAUSES[r["name"]]
+    pars = mod.parameters(np.array([r["x"]]), {}, model)
+    base = mod.parameters(np.zeros(1), {}, model)
+    return pars, {k: float(pars[k] - base[k]) for k in pars}
+
+
+def _loop_admission(fc: dict, fit: Measurement, validate: Measurement) -> dict:
+    """The force channel's result ``fc`` with the noise-fed causes that failed only along the
+    reference trajectory (``reference_only``) judged on the loop: re-simulated on the force
+    channel's extended model, the best of them on the fitting record (one parameter fitted there,
+    :func:`hunting.diagnose.loop_channel.judge`) is admitted when it cuts both records' position
+    error by at least LOOP_GAIN; the others' rejections say what the loop found. The reference
+    trajectory guards against the loop's reaction to its own noise, which a force residual cannot
+    tell from a delay or a mass; a re-simulated loop has no such noise to react to. On development
+    sets reporting14 and reporting15 the delays and masses of 107 clean records failed that way;
+    fitted on the loop none reached the bar on both records (the largest: 0.40 and 0.52, r14
+    d0121's mass), while reporting15 d0404 and d0488 (delays of 2.7 and 4.2 ms, named by nothing
+    before) reached 0.66/0.80 and 0.98/0.82, their delays within 5 %."""
+    from . import loop_channel
+    rows = [r for r in fc["rejected"] if r.get("reference_only")]
+    if not rows:
+        return fc
+    v = loop_channel.judge(fit, validate, fc["model"], [r["name"] for r in rows])
+    verdicts = {x["name"]: x["reason"] for x in v["rejected"]}
+    rejected = []
+    for row in fc["rejected"]:
+        if row.get("reference_only") and row["name"] in verdicts:
+            row = dict(row, reason=f"{row['reason']}; and on the loop: {verdicts[row['name']]}")
+        if v["cause"] is None or row["name"] != v["cause"]["name"]:
+            rejected.append(row)
+    out = dict(fc, rejected=rejected)
+    r = v["cause"]
+    if r is None:
+        return out
+    row = next(x for x in rows if x["name"] == r["name"])
+    why = (f"significant on the validation residual (p = {row['p_value']:.2g}) but not along the reference trajectory, "
+           "where the loop's reaction to its own noise cannot pass for it")
+    out["causes"] = list(fc["causes"]) + [_loop_cause(r, fc["model"], loop_channel.evidence_text(r, why),
+                                                      row["statistic"], row["p_value"])]
+    out["model"] = loop_channel.extended(r["name"], fc["model"], r["x"])
     return out
 
 
