@@ -664,3 +664,32 @@ def test_the_loop_channel_names_only_the_best_candidate_on_the_fitting_record(mo
     reasons = {r["name"]: r["reason"] for r in v["rejected"]}
     assert "level fitted the fitting record's loop better" in reasons["offset"]
     assert "cuts the validation record's position error by 20.0%" in reasons["level"]
+
+
+def test_a_delay_the_reference_check_cannot_confirm_is_judged_on_the_loop():
+    """reporting15 d0488, a transport delay of 4.2 ms: significant on the validation residual, but
+    its prediction along the noise-free reference trajectory does not hold (the check against the
+    loop's reaction to its own noise), and the start code reported nothing. Fitted on the fitting
+    record's re-simulated loop it cuts both records' position error by more than LOOP_GAIN: named,
+    the delay within 5 %, with the force channel's p-value and the loop's evidence."""
+    from hunting.diagnose.causes.presliding import LOOP_GAIN
+    fit, val, model, truth = _dataset("reporting15", 488)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["delay"], [(c.name, c.parameters) for c in d.causes]
+    c = d.causes[0]
+    assert c.parameters["delay"] == pytest.approx(truth["effects"][0]["params"]["delay"], rel=0.05)
+    assert c.p_value < 1e-3 and "not along the reference trajectory" in c.gain["evidence"]
+    assert 1 - c.gain["extended"] / c.gain["nominal"] >= LOOP_GAIN
+    assert d.extended_model.delay == pytest.approx(c.parameters["delay"])
+
+
+def test_a_clean_cause_the_reference_check_rejects_stays_rejected_on_the_loop():
+    """reporting15 d0008 (clean): a noise-fed cause that fails only along the reference
+    trajectory; fitted on the loop it cuts the fitting record's position error by 18 %, less than
+    LOOP_GAIN, and the rejection says so."""
+    fit, val, model, truth = _dataset("reporting15", 8)
+    assert truth["causes"] == []
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == []
+    rows = [r for r in d.rejected if r.get("reference_only")]
+    assert rows and all("; and on the loop: " in r["reason"] for r in rows)
