@@ -246,7 +246,8 @@ def growth_test(t, e, s, scale, *, draws: int = DRAWS, seed: int = 0) -> tuple[f
     no order, and Spearman's rank of t (the old statistic) weighed their noise as much as the
     growth (reporting15 d0366: readings within 0.06 N of a 0.6 N growth complete by 0.15 s, 11
     of 16 rests beyond it: p = 1.1e-3; with the saturating score 2.5e-4; on the clean records of
-    reporting13 and reporting14 p < 1e-3 stayed 1 of 270 and 1 of 257). As tau grows the score
+    reporting13 and reporting14 p < 1e-3 stayed 1 of 270 and 1 of 257; on the reporting16 verdict
+    one clean record more fell just under, d0190 at 9.99e-4). As tau grows the score
     tends to the correlation with t itself. p: one-sided, Freedman and Lane's permutation test (r
     permuted inside each direction, added to the null's fit, refitted, ranked and scored again,
     the maximum over tau taken for every draw, so the choice of tau costs what it should;
