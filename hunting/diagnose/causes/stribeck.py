@@ -13,11 +13,14 @@ the new one (``shift``).
 One variant more holds the nominal shape and Coulomb level and fits the static level alone
 (``dip``: c2 at the model's own vs and beta, no hyper-parameter searched): the commonest Stribeck
 error, and the only one a record whose speeds barely reach the dip can pin down. With c1 free, such
-a record traded c1 against c2 (reporting15 d0443, a static level 0.76 -> 0.68 N at the nominal
-shape: c1 = -0.42 N, c2 = +0.95 N at vs 9.4 mm/s, fitting the record and predicting the validation
-record 110 times worse than the nominal; d0471, d0513 alike). The search picks between variants by
-BIC (:meth:`hunting.diagnose.force.Library.best_variants`), so the two-coefficient variants win
-only where their freedom pays."""
+a record traded c1 against c2 (reporting15 d0513, a static level 3.25 -> 2.82 N at the nominal
+shape: vs 3.9 mm/s, c1 = +0.025 N, c2 = -0.43 N, a validation residual 4 times the nominal's; with
+this variant Fs within 0.2 %). The search picks between variants by BIC
+(:meth:`hunting.diagnose.force.Library.best_variants`), so the two-coefficient variants win only
+where their freedom pays; on records that leave the force channel very few samples they still do
+(reporting15 d0443, 61 whitened samples: c1 = -0.42 N, c2 = +0.95 N at vs 9.4 mm/s, beating the
+static level alone by 16 in BIC and predicting the validation record 110 times worse than the
+nominal; missed)."""
 from dataclasses import replace
 
 import numpy as np
