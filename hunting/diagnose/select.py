@@ -66,7 +66,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "least {loop_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
         "that fitted on the fitting record's loop cuts its position error most, when it cuts both records' by at least "
         "{loop_gain:.0%}; a noise-fed cause that fails only along the reference trajectory, when fitted on the fitting "
-        "record's loop it cuts both records' position error by at least {loop_gain:.0%}")
+        "record's loop it cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
+        "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts both records' "
+        "position error by at least {loop_gain:.0%}")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -222,8 +224,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     check_units(kv, model, validate.name)
     from .force import REFERENCE_GAIN
     from .causes.presliding import LOOP_GAIN
+    from .causes.dwell_loop import GATE as DWELL_GATE
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
-                      reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN)
+                      reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN,
+                      dwell_gate=DWELL_GATE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
@@ -837,9 +841,13 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     (Cause or None, rejected row or None, model)."""
     v = mod.judge(fit, val, kf, kv, model, can_sim, resolution)
     first = _own_failure(v, alpha, min_gain)
-    if first is not None and "otherwise" in v and _own_failure(v["otherwise"], alpha, min_gain) is None:
-        rival = unruled(v["otherwise"].get("rivals", ()))
-        v, first = v["otherwise"], (None if rival is None else f"{v['otherwise']['evidence']}; but {rival}")
+    if first is not None and "otherwise" in v:
+        second = _own_failure(v["otherwise"], alpha, min_gain)
+        if second is None:
+            rival = unruled(v["otherwise"].get("rivals", ()))
+            v, first = v["otherwise"], (None if rival is None else f"{v['otherwise']['evidence']}; but {rival}")
+        else:
+            first = f"{first}; and {second}"
     row = dict(name=mod.NAME, step="own", statistic=v.get("statistic"), p_value=v.get("p_value"))
     if "reason" in v:
         return None, dict(row, validation_gain=None, reason=v["reason"], untested=bool(v.get("untestable"))), model
