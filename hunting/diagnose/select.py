@@ -60,7 +60,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "prewhitened, autocorrelation-consistent standard error, Student's t with the validation data's filter windows less one as degrees of freedom, p < {alpha:g}; with a moving reference its prediction "
         "along the reference too, p < {alpha_reference:g}, and, with a controller in the model, that prediction's shape, alone and with "
         "the other noise-fed causes', explains at least {reference_gain:.1%} of it), dropping it grows the validation RMS by at least "
-        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by as much, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
+        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much and by {swap_share:.0%} of the nominal model's validation residual, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by both, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%}; presliding, where no creep shows at rest, also "
         "when LuGre bristles fitted on the fitting record's re-simulated loop cut both records' position error by at "
         "least {loop_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
@@ -222,12 +222,12 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     kv = kinematics(validate, model.cm, window=window, **sensor)
     check_units(kf, model, fit.name)
     check_units(kv, model, validate.name)
-    from .force import REFERENCE_GAIN
+    from .force import REFERENCE_GAIN, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN
     from .causes.dwell_loop import GATE as DWELL_GATE
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN,
-                      dwell_gate=DWELL_GATE)
+                      dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
