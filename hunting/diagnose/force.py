@@ -68,9 +68,8 @@ IV_MIN_CORR = 0.5     # a noise-fed regressor is instrumented when its instrumen
 # a change of explanation toward more freedom or another set (the general case in its special
 # case's place, a rival set of as many causes) must also gain this share of the nominal model's
 # validation residual: where both explain nearly all of it, what is left is noise, and min_gain of
-# it decides nothing (reporting16 d0384: a true offset and a
-# Stribeck change each removed 98.9 % of 0.187 N; the Stribeck change, 5.1 % better on the 0.002 N
-# left, replaced it). On the development sets the swaps made gained 0.0014-0.0142 (each replacing
+# it decides nothing (reporting16 d0384: a true offset and a Stribeck change each removed 98.9 % of
+# 0.187 N; the Stribeck change, 5.1 % better on the 0.002 N left, replaced it). On the development sets the swaps made gained 0.0014-0.0142 (each replacing
 # the true cause) or 0.041-0.31 of the nominal residual (reporting14 d0486's viscous: 0.050).
 SWAP_SHARE = 0.02
 REFERENCE_GAIN = 0.5  # a noise-fed cause's part along a noise-free loop must remove this share of min_gain

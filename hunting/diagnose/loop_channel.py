@@ -18,7 +18,8 @@ the second record holds the bar. Six records gained their true cause (offset, le
 delay, lag), each parameter within 11 %. Wrong candidates reached 42-48 % on the validation
 record on three effect records (saturation, LuGre bristles, a mass's rival): near the bar. On the
 reporting16 verdict one clean record of the skipped ones passed (d0195: an offset at 60 % on both
-records): the bar needs more clean records than the development sets had. The evidence is not a p-value: a stick-slip loop's position error is not a sum of independent terms."""
+records): the bar needs more clean records than the development sets had. The evidence is not a
+p-value: a stick-slip loop's position error is not a sum of independent terms."""
 from __future__ import annotations
 
 import numpy as np
