@@ -71,18 +71,18 @@ def _pass_builder_without_unrolling(tm, opt=2, loop_vectorize=False, slp_vectori
 
 
 @contextmanager
-def _small_loops(small: bool):
-    """While compiling: LLVM pass pipelines without the loop vectorizer and the loop unroller
-    when ``small``. numba reads LOOP_VECTORIZE each time it builds a pipeline; unrolling has no
-    numba setting, so its pipeline factory is swapped (only when it has the expected name).
-    Both are restored afterwards."""
+def _loop_passes(vectorize: bool, unroll: bool):
+    """While compiling: LLVM pass pipelines without the loop vectorizer (``vectorize=False``)
+    and without the loop unroller (``unroll=False``). numba reads LOOP_VECTORIZE each time it
+    builds a pipeline; unrolling has no numba setting, so its pipeline factory is swapped (only
+    when it has the expected name). Both are restored afterwards."""
     saved_vec = numba.config.LOOP_VECTORIZE
     saved_pb = getattr(_numba_codegen, "create_pass_builder", None)
     try:
-        if small:
+        if not vectorize:
             numba.config.LOOP_VECTORIZE = False
-            if saved_pb is not None:
-                _numba_codegen.create_pass_builder = _pass_builder_without_unrolling
+        if not unroll and saved_pb is not None:
+            _numba_codegen.create_pass_builder = _pass_builder_without_unrolling
         yield
     finally:
         numba.config.LOOP_VECTORIZE = saved_vec
@@ -90,18 +90,18 @@ def _small_loops(small: bool):
             _numba_codegen.create_pass_builder = saved_pb
 
 
-def compile_for(disp, sig, small_loops: bool = False):
+def compile_for(disp, sig, *, vectorize: bool = True, unroll: bool = True):
     """Compile numba dispatcher ``disp`` for signature ``sig`` unless it has an overload (numba
     loads it from its disk cache when there) and disable compilation for other types: arguments
     that do not match are an error instead of a silent new specialization. What
     ``numba.njit(sig)`` does at import, done on first use (so importing a module compiles
     nothing a command does not run). Returns ``disp``.
 
-    ``small_loops=True`` compiles it (and the functions it compiles in turn) without LLVM's
-    loop vectorizer and unroller, for code whose loops run over a few states only: their
-    vector and unrolled copies of every loop cost compile time and no run time there."""
+    ``vectorize=False`` and ``unroll=False`` compile it (and the functions it compiles in turn)
+    without LLVM's loop vectorizer and loop unroller: for code whose loops run over a few states
+    only, their vector and unrolled copies of every loop cost compile time and no run time."""
     if not disp.overloads:
-        with _small_loops(small_loops), warnings.catch_warnings():
+        with _loop_passes(vectorize, unroll), warnings.catch_warnings():
             # compiling inside a caller's warning context (pytest's resets the filter that
             # hunting._fastcall installs at import)
             warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)

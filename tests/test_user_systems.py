@@ -97,9 +97,10 @@ def test_memoized_function_addresses_match_numba():
             assert ft._get_jit_address(fn, sig) == _fastcall._orig_jit(fn, sig)
 
 
-def test_compile_for_small_loops_restores_numba_settings():
-    """The lean kernel's compile without LLVM's loop vectorizer and unroller leaves numba's
-    settings as they were for everything compiled afterwards."""
+@pytest.mark.parametrize("vectorize, unroll", [(False, False), (True, False), (False, True)])
+def test_compile_for_without_loop_passes_restores_numba_settings(vectorize, unroll):
+    """A kernel's compile without LLVM's loop vectorizer or unroller leaves numba's settings as
+    they were for everything compiled afterwards."""
     import numba.core.codegen as codegen
     from hunting.system import VF_SIG, compile_for
 
@@ -109,7 +110,7 @@ def test_compile_for_small_loops_restores_numba_settings():
             out[i] = -x[i]
 
     before = (numba.config.LOOP_VECTORIZE, getattr(codegen, "create_pass_builder", None))
-    compile_for(vf, VF_SIG, small_loops=True)
+    compile_for(vf, VF_SIG, vectorize=vectorize, unroll=unroll)
     assert (numba.config.LOOP_VECTORIZE, getattr(codegen, "create_pass_builder", None)) == before
     out = np.empty(3)
     vf(0, 0.0, np.arange(3.0), np.empty(0), out)

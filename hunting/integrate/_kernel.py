@@ -845,11 +845,15 @@ _DISPATCHERS = {"lean": numba.njit(**_OPTIONS)(_make_kernel(None)), "full": numb
 def compiled(kind: str):
     """The kernel ``kind`` ("lean" or "full"), compiled for KERNEL_SIG on first use.
 
-    The lean kernel compiles without LLVM's loop vectorizer and unroller: its loops run over
-    the states of one system (3-4 for the presets), too few for vector code or unrolled copies,
-    which took ~1.3 s and ~1-2 s of its ~12 s compile at the same run time. The full kernel
-    keeps them (with sensitivities its loops run over n (n + 1) entries)."""
-    return compile_for(_DISPATCHERS[kind], KERNEL_SIG, small_loops=kind == "lean")
+    Both compile without LLVM's loop unroller, the lean kernel without its loop vectorizer too:
+    its loops run over the states of one system (3-4 for the presets), too few for vector code
+    or unrolled copies, which took ~1.3 s and ~1-2 s of its ~12 s compile at the same run time.
+    The full kernel's loops run over n (n + 1) sensitivity entries and keep vector code; without
+    unrolled copies it compiles in ~27 instead of ~40 s CPU (with the functions it compiles in
+    turn, 2 runs each) and runs as fast (flows of table 9.1 and a 4-state LuGre loop, DOP853 with
+    and without sensitivities and Radau: 0.9-1.2 times the run time, the machine's spread, and
+    bit-identical states)."""
+    return compile_for(_DISPATCHERS[kind], KERNEL_SIG, vectorize=kind != "lean", unroll=False)
 
 
 def kernel_for(method: int):

@@ -250,7 +250,7 @@ def build_servo_system(name: str, params: np.ndarray, *, odd: bool, units: dict)
     # `hunting models`, --help) does not pay the ~3 s of compiling these on a fresh install
     for fn, sig in ((servo_vf, VF_SIG), (servo_guards, GUARD_SIG), (servo_reset, RESET_SIG),
                     (servo_mode_of, MODE_SIG)):
-        compile_for(fn, sig, small_loops=True)
+        compile_for(fn, sig, vectorize=False, unroll=False)
     # the Jacobian only when a kernel calls it (Radau, sensitivities): not for simulations and
     # event maps, which run the lean kernel
     compile_later(servo_jac, JAC_SIG)
