@@ -28,6 +28,24 @@ def test_monodromy_matches_finite_differences_of_the_flow(name, kw, x0, T, metho
     assert np.abs(fl.Phi - J).max() <= 1e-6 * np.abs(J).max()
 
 
+def test_the_variational_kernel_runs_dop853_as_the_full_one_does(monkeypatch):
+    """Flows with DOP853 run the variational kernel (no DP5 or Radau step compiled in); the full
+    kernel, which carries every method, gives the same states, fundamental matrix, parameter
+    sensitivity and events bit for bit."""
+    from hunting.integrate import _kernel as K
+    sys_ = preset("table8.1-lugre", K=0.3).system
+    x0, T = [-0.02, 0.05, 0.01, 1e-5], 0.5
+    dp = (preset("table8.1-lugre", K=0.31).system.params - preset("table8.1-lugre", K=0.29).system.params) / 0.02
+    assert K.flow_kernel(K.METHOD_DOP853) is K.compiled("variational")
+    assert K.flow_kernel(K.METHOD_RADAU) is K.compiled("full")
+    a = flow(sys_, x0, T, param_direction=dp)
+    monkeypatch.setattr(K, "flow_kernel", lambda method: K.compiled("full"))
+    b = flow(sys_, x0, T, param_direction=dp)
+    assert a.ok and len(a.event_times) >= 2
+    for name in ("x", "Phi", "dx_dmu", "event_times", "modes"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
 @pytest.mark.parametrize("name,kw,par,x0,T,method", [
     ("table9.1", {}, "P", [0.1, -0.2, 0.03], 2.5, "dop853"),                 # stick exit moves with P
     ("table9.1", dict(beta="inf"), "Fs", [0.1, -0.2, 0.03], 2.5, "dop853"),  # the jump in f moves with Fs

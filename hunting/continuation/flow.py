@@ -76,12 +76,13 @@ def flow(system: PiecewiseSystem, x0, T: float, *, mode0: int | None = None, par
     yf = np.empty(N)
     jac, has_jac = kernel_jacobian(system)
     nf, ni = K.workspace_sizes(N, n, system.n_guards, system.n_modes, 50)
-    K.integrate_kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
-                       has_jac, METHODS[method], n, 0.0, float(T), y0,
-                       -1 if mode0 is None else int(mode0), p, dpw, system.directions, rtol, atol, 0.0, hmax,
-                       int(max_steps), int(max_events), guard_tol, False, np.empty(0), False, int(stop_mode),
-                       int(stop_count), 50, 1e-12 * T, out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f,
-                       ev_to, info, finfo, yf, np.empty(nf), np.empty(ni, dtype=np.int64))
+    kernel = K.flow_kernel(METHODS[method])
+    kernel(system.vector_field, system.guards, system.transition, jac, system.mode_of,
+           has_jac, METHODS[method], n, 0.0, float(T), y0,
+           -1 if mode0 is None else int(mode0), p, dpw, system.directions, rtol, atol, 0.0, hmax,
+           int(max_steps), int(max_events), guard_tol, False, np.empty(0), False, int(stop_mode),
+           int(stop_count), 50, 1e-12 * T, out_t, out_x, out_m, ev_t, ev_xb, ev_xa, ev_g, ev_f,
+           ev_to, info, finfo, yf, np.empty(nf), np.empty(ni, dtype=np.int64))
     st = Status(int(info[K.I_STATUS]))
     if st == Status.BUFFER_FULL:
         st = Status.MAX_EVENTS

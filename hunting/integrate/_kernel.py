@@ -334,13 +334,15 @@ def workspace_sizes(n, nb, ng, n_modes, zeno_count):
     return nf, 4 * n + ng
 
 
-def _make_kernel(full_flag):
-    """The kernel body as a closure over ``FULL`` (None: lean, True: full). numba prunes
+def _make_kernel(full_flag, implicit_flag):
+    """The kernel body as a closure over ``FULL`` (None: lean, True: with sensitivities) and
+    ``IMPLICIT`` (whether it carries the DP5 and Radau IIA steps besides DOP853). numba prunes
     branches on closure constants before typing and keys its disk cache on their values, so
-    both kernels come from this one source and are cached side by side. (An inlined body shared
-    by two entries does not work: calls with more than 30 arguments compile to f(*args), which
-    numba cannot inline.)"""
+    the kernels come from this one source and are cached side by side. (An inlined body shared
+    by several entries does not work: calls with more than 30 arguments compile to f(*args),
+    which numba cannot inline.)"""
     FULL = full_flag
+    IMPLICIT = implicit_flag
 
     def integrate_kernel(vf, guards, reset, jac, mode_of, has_jac, method, nb,
                          t0, t1, x0, mode0, p, dpw, directions,
@@ -575,7 +577,7 @@ def _make_kernel(full_flag):
                     break
                 hs = h
             conv = True
-            if full is not None and method == METHOD_RADAU:
+            if full is not None and IMPLICIT and method == METHOD_RADAU:
                 if not polishing:
                     if not sens:
                         if has_jac:
@@ -597,7 +599,7 @@ def _make_kernel(full_flag):
                 # inlined here (the hot path: a call passing ~25 array arguments cost 5-8 % per
                 # step). The lean kernel prunes the DP5 branch before inlining, so it never copies
                 # the DP5 step.
-                if full is not None and method == METHOD_DP5:
+                if full is not None and IMPLICIT and method == METHOD_DP5:
                     en = dp5_step(vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, f, hs, p, rtol, atol, K,
                                   ytmp, y_new, f_new, err, full)
                 else:
@@ -654,7 +656,7 @@ def _make_kernel(full_flag):
                 for i in range(ng):
                     if (not armed[i]) or _fires(directions[mode, i], g_old[i], g_new[i], 0.0):
                         need_dense = True
-                if full is not None and method == METHOD_RADAU:
+                if full is not None and IMPLICIT and method == METHOD_RADAU:
                     radau_dense(Z, Q)
                 elif need_dense:
                     nfev += explicit_dense(method, vf, jac, has_jac, nb, yw, fw, fp, fm, Jw, dpw, mode, t, x, y_new, f_new, h, p,
@@ -831,35 +833,46 @@ def _make_kernel(full_flag):
     return integrate_kernel
 
 
-# ---- the compiled kernels: two entries of one body, each compiled on first use
+# ---- the compiled kernels: three entries of one body, each compiled on first use
 #
-# Both take KERNEL_SIG, so one compiled kernel of each kind serves every system and parameter
+# All take KERNEL_SIG, so one compiled kernel of each kind serves every system and parameter
 # value. The lean kernel (DOP853, no sensitivities: simulations and event maps) is a third of
-# the full one's compile time; the full kernel (DP5, Radau IIA, sensitivities and saltation
-# matrices) compiles only when a command needs it. Neither compiles at import.
+# the full one's compile time; the variational kernel (DOP853 with sensitivities and saltation
+# matrices: flows, shooting, continuation) leaves out the DP5 and Radau IIA steps, the full
+# kernel (every method, sensitivities) compiles only when a command asks for DP5 or Radau.
+# None compiles at import.
 
 _OPTIONS = dict(cache=True, error_model="numpy", _nrt=False, nogil=True)
-_DISPATCHERS = {"lean": numba.njit(**_OPTIONS)(_make_kernel(None)), "full": numba.njit(**_OPTIONS)(_make_kernel(True))}
+KINDS = {"lean": (None, False), "variational": (True, False), "full": (True, True)}
+_DISPATCHERS = {kind: numba.njit(**_OPTIONS)(_make_kernel(*flags)) for kind, flags in KINDS.items()}
 
 
 def compiled(kind: str):
-    """The kernel ``kind`` ("lean" or "full"), compiled for KERNEL_SIG on first use.
+    """The kernel ``kind`` (one of KINDS: "lean", "variational" or "full"), compiled for
+    KERNEL_SIG on first use. The variational kernel runs DOP853 only: give it no other method.
 
-    Both compile without LLVM's loop unroller, the lean kernel without its loop vectorizer too:
+    All compile without LLVM's loop unroller, the lean kernel without its loop vectorizer too:
     its loops run over the states of one system (3-4 for the presets), too few for vector code
     or unrolled copies, which took ~1.3 s and ~1-2 s of its ~12 s compile at the same run time.
-    The full kernel's loops run over n (n + 1) sensitivity entries and keep vector code; without
-    unrolled copies it compiles in ~27 instead of ~40 s CPU (with the functions it compiles in
-    turn, 2 runs each) and runs as fast (flows of table 9.1 and a 4-state LuGre loop, DOP853 with
-    and without sensitivities and Radau: 0.9-1.2 times the run time, the machine's spread, and
-    bit-identical states)."""
+    The kernels with sensitivities loop over n (n + 1) entries and keep vector code; without
+    unrolled copies the full kernel compiles in ~27 instead of ~40 s CPU (with the functions it
+    compiles in turn, 2 runs each) and runs as fast (flows of table 9.1 and a 4-state LuGre
+    loop, DOP853 with and without sensitivities and Radau: 0.9-1.2 times the run time, the
+    machine's spread, and bit-identical states)."""
     return compile_for(_DISPATCHERS[kind], KERNEL_SIG, vectorize=kind != "lean", unroll=False)
+
+
+def flow_kernel(method: int):
+    """The compiled kernel that runs ``method`` (METHOD_*) with sensitivities: the variational
+    kernel for DOP853, else the full one."""
+    return compiled("full" if method != METHOD_DOP853 else "variational")
 
 
 def kernel_for(method: int):
     """The compiled kernel that runs ``method`` (METHOD_*) without sensitivities: the lean
-    kernel for DOP853, else the full one (flows with sensitivities call ``integrate_kernel``;
-    without them a flow runs as fast on either: 149 vs 161 us per period of table 9.1)."""
+    kernel for DOP853, else the full one (flows call :func:`flow_kernel` with or without
+    sensitivities: without them a flow runs as fast on either, 149 vs 161 us per period of
+    table 9.1)."""
     return compiled("full" if calls_jacobian(method) else "lean")
 
 
@@ -873,6 +886,4 @@ def __getattr__(name: str):
     # integrate_kernel: the full kernel, compiled on first access (PEP 562)
     if name == "integrate_kernel":
         return compiled("full")
-    if name == "lean_kernel":
-        return compiled("lean")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
