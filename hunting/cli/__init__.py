@@ -28,8 +28,10 @@ line, in the command line's words (:mod:`hunting.cli.advice`): exit code 2 for b
 a numerical failure. ``--debug`` shows the traceback.
 
 A command is a module in this package with ``NAME``, ``HELP``, ``add_arguments(parser)``,
-``run(args, results) -> exit code`` and optionally ``files(args) -> (outputs, inputs)``; it is
-registered by its module name in ``COMMANDS``.
+``run(args, results) -> exit code`` and optionally ``files(args) -> (outputs, inputs)`` and
+``kernels(args)`` (the integration kernels it runs, compiled ahead in a second process on a
+fresh install: :mod:`hunting.integrate.ahead`); it is registered by its module name in
+``COMMANDS``.
 """
 from __future__ import annotations
 
@@ -115,6 +117,17 @@ def _say_error(message: str, command: Command | None = None) -> None:
     print(f"hunting: error: {one_line}", file=sys.stderr)
 
 
+def _kernels_ahead(cmd, args):
+    """On a fresh install, the integration kernels command ``cmd`` declares (``kernels(args)``)
+    compile in a helper process while the command does its other work
+    (:mod:`hunting.integrate.ahead`)."""
+    kinds = cmd.kernels(args) if hasattr(cmd, "kernels") else ()
+    if not kinds:
+        return contextlib.nullcontext()
+    from ..integrate.ahead import compiling_ahead
+    return compiling_ahead(kinds)
+
+
 def _quiet_stdout() -> None:
     """After a broken pipe: point stdout at devnull so the interpreter's final flush is silent."""
     with contextlib.suppress(OSError, ValueError, AttributeError):
@@ -141,7 +154,8 @@ def main(argv=None) -> int:
         results = Results(sys.stdout)
         # with results on stdout, everything a command says goes to stderr
         redirect = contextlib.redirect_stdout(sys.stderr) if to_stdout else contextlib.nullcontext()
-        with _warnings_to_stderr(lambda text: for_cli(text, command)), _python_warnings_one_line(), redirect:
+        with _kernels_ahead(cmd, args), _warnings_to_stderr(lambda text: for_cli(text, command)), \
+                _python_warnings_one_line(), redirect:
             code = cmd.run(args, results)
         sys.stdout.flush()
         return code

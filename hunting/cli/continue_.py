@@ -47,6 +47,12 @@ def add_arguments(p) -> None:
 files = result_files
 
 
+def kernels(args) -> tuple[str, ...]:
+    """The kernel of this command's flows, compiled ahead on a fresh install while this process
+    compiles the system and the kernels of its start."""
+    return ("variational",)
+
+
 @dataclass(frozen=True)
 class Outcome:
     """How a branch ended, for the user: exit code, one line, and whether it reached --to."""

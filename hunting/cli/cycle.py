@@ -41,6 +41,12 @@ def add_arguments(p) -> None:
 files = result_files
 
 
+def kernels(args) -> tuple[str, ...]:
+    """The kernel of this command's flows, compiled ahead on a fresh install while this process
+    compiles the model and the lean kernel of its transient simulation."""
+    return ("variational",)
+
+
 def run(args, results) -> int:
     from ..continuation import StartOptions, find_cycle
     from ..plotting import cycle_panels, plot_cycle

@@ -17,6 +17,12 @@ def files(args):
     return [Output("--out", args.out, "dir")], []
 
 
+def kernels(args) -> tuple[str, ...]:
+    """The kernel of the demo's Radau run, compiled ahead on a fresh install while this process
+    compiles the lean kernel of the others."""
+    return ("full",)
+
+
 def run(args, results) -> int:
     from ..demo import run_demo
     return run_demo(Path(args.out))

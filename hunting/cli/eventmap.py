@@ -26,6 +26,11 @@ def add_arguments(p) -> None:
 files = result_files
 
 
+def kernels(args) -> tuple[str, ...]:
+    """The integration kernels this command runs (compiled ahead on a fresh install)."""
+    return ("lean",)
+
+
 def run(args, results) -> int:
     from ..errors import Status
     from ..eventmap import check_resolution, event_map, stick_family

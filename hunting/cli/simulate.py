@@ -40,6 +40,11 @@ def add_arguments(p) -> None:
 files = result_files
 
 
+def kernels(args) -> tuple[str, ...]:
+    """The integration kernels this command runs (compiled ahead on a fresh install)."""
+    return ("lean",) if args.method == "dop853" else ("full",)
+
+
 def thinned(m: int, max_samples: int):
     """Indices of at most ``max_samples`` of ``m`` points, evenly spread, first and last kept;
     None when all are kept (``max_samples`` 0 or >= m)."""

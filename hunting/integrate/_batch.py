@@ -156,8 +156,10 @@ def run_batch(system, X0, mode0, *, t_max: float, atol, rtol: float = 1e-12, met
     n_events = np.empty(m, dtype=np.int64)
     fout = np.empty((m, N_BFLOAT))
     jac, has_jac = kernel_jacobian(system, used=K.calls_jacobian(int(method)))
-    kernel = K.kernel_for(int(method))
+    # the batch before the kernel: on a fresh install a helper process may be compiling the
+    # kernel meanwhile (hunting.integrate.ahead)
     batch = K.compile_for(batch_kernel, BATCH_SIG)
+    kernel = K.kernel_for(int(method))
 
     def rows(lo: int, hi: int) -> None:
         batch(kernel, system.vector_field, system.guards, system.transition, jac, system.mode_of,

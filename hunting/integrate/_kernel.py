@@ -18,6 +18,7 @@ from numba import types
 
 from ..errors import Status
 from ..system import GUARD_TYPE, JAC_TYPE, MODE_TYPE, RESET_TYPE, VF_TYPE, compile_for
+from . import ahead
 from ._rhs import jacobian_central_or_exact, param_step, rhs
 from ._steppers import (EPS, dense_eval, dop853_step, dp5_step, explicit_dense, numerical_jacobian,
                         radau_dense, radau_step, select_initial_step)
@@ -858,8 +859,14 @@ def compiled(kind: str):
     unrolled copies the full kernel compiles in ~27 instead of ~40 s CPU (with the functions it
     compiles in turn, 2 runs each) and runs as fast (flows of table 9.1 and a 4-state LuGre
     loop, DOP853 with and without sensitivities and Radau: 0.9-1.2 times the run time, the
-    machine's spread, and bit-identical states)."""
-    return compile_for(_DISPATCHERS[kind], KERNEL_SIG, vectorize=kind != "lean", unroll=False)
+    machine's spread, and bit-identical states).
+
+    Where a helper process compiles it (:mod:`hunting.integrate.ahead`), this waits for the
+    helper and loads it from the cache."""
+    disp = _DISPATCHERS[kind]
+    if not disp.overloads:
+        ahead.wait_for(kind)
+    return compile_for(disp, KERNEL_SIG, vectorize=kind != "lean", unroll=False)
 
 
 def flow_kernel(method: int):

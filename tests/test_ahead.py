@@ -1,0 +1,82 @@
+"""Kernels compiled ahead in a helper process (hunting.integrate.ahead)."""
+import json
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+
+from hunting.integrate import ahead
+
+# the command line inside a listener for numba's compile events (as benchmarks/bench_coldstart.py)
+RUNNER = r"""
+import contextlib, io, json, sys
+from numba.core import event as ev
+compiled = []
+class Listener(ev.Listener):
+    def on_start(self, event):
+        d = event.data.get("dispatcher")
+        if d is not None:
+            compiled.append(d.py_func.__qualname__)
+    def on_end(self, event):
+        pass
+ev.register("numba:compile", Listener())
+from hunting.cli import main
+out = io.StringIO()
+with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+    code = main(sys.argv[1:])
+print(json.dumps(dict(code=code, compiled=compiled, out=out.getvalue())))
+"""
+
+
+def _cold_cli(tmp_path, switch: str, *args) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), HUNTING_CACHE_DIR=str(tmp_path / "models"))
+    env[ahead.ENV_SWITCH] = switch
+    out = subprocess.run([sys.executable, "-c", RUNNER, *args], env=env, capture_output=True, text=True,
+                         timeout=600, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.skipif(ahead._cores() < 2, reason="compiling ahead needs a second core")
+def test_a_fresh_install_loads_the_kernel_the_helper_compiled(tmp_path):
+    """On empty caches, `hunting simulate` starts a helper that compiles the lean kernel; the
+    command itself compiles the preset's functions meanwhile and loads the kernel from the cache
+    (no compile of integrate_kernel in its own process), with the same printed result."""
+    args = ("simulate", "table9.1", "--x0", "0.1,0,0", "--t", "2")
+    res = _cold_cli(tmp_path, "1", *args)
+    assert res["code"] == 0
+    assert not [q for q in res["compiled"] if "integrate_kernel" in q], res["compiled"]
+    assert any("servo_vf" in q for q in res["compiled"])
+    warm = _cold_cli(tmp_path, "0", *args)          # the same caches, now warm
+    assert warm["code"] == 0 and warm["out"] == res["out"] and "SUCCESS" in res["out"]
+    assert not [q for q in warm["compiled"] if "integrate_kernel" in q]
+
+
+def test_no_helper_when_switched_off_with_one_core_or_cached(monkeypatch):
+    monkeypatch.setattr(ahead, "cached", lambda kind: False)
+    monkeypatch.setenv(ahead.ENV_SWITCH, "0")
+    assert ahead.start(["lean"]) is False
+    monkeypatch.setenv(ahead.ENV_SWITCH, "1")
+    monkeypatch.setattr(ahead, "_cores", lambda: 1)
+    assert ahead.start(["lean"]) is False
+    monkeypatch.setattr(ahead, "_cores", lambda: 2)
+    monkeypatch.setattr(ahead, "cached", lambda kind: True)
+    assert ahead.start(["lean", "variational"]) is False
+    assert ahead._helper is None
+    with pytest.raises(ValueError, match=r"kernel kind = 'batch' is not allowed: use one of \('lean'"):
+        ahead.start(["batch"])
+
+
+def test_the_wait_for_a_helper_is_bounded(monkeypatch):
+    """A helper that never caches the kernel: the wait ends at its limit and stops the helper
+    (the command then compiles the kernel itself)."""
+    proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    monkeypatch.setattr(ahead, "_helper", ahead._Helper(proc, ("full",)))
+    monkeypatch.setattr(ahead, "cached", lambda kind: False)
+    t0 = time.monotonic()
+    ahead.wait_for("lean", limit=5.0)                   # not the helper's: no wait
+    assert time.monotonic() - t0 < 0.5
+    ahead.wait_for("full", limit=0.3)
+    assert 0.3 <= time.monotonic() - t0 < 6.0
+    assert proc.poll() is not None and ahead._helper is None
