@@ -54,18 +54,26 @@ def test_a_fresh_install_loads_the_kernel_the_helper_compiled(tmp_path):
 
 
 def test_no_helper_when_switched_off_with_one_core_or_cached(monkeypatch):
-    monkeypatch.setattr(ahead, "cached", lambda kind: False)
+    from hunting.integrate import _kernel as K
+    targets = {"lean": (K._DISPATCHERS["lean"], K.KERNEL_SIG)}
+    monkeypatch.setattr(ahead, "cached", lambda disp, sig: False)
     monkeypatch.setenv(ahead.ENV_SWITCH, "0")
-    assert ahead.start(["lean"]) is False
+    assert ahead.start(targets) is False
     monkeypatch.setenv(ahead.ENV_SWITCH, "1")
     monkeypatch.setattr(ahead, "_cores", lambda: 1)
-    assert ahead.start(["lean"]) is False
+    assert ahead.start(targets) is False
     monkeypatch.setattr(ahead, "_cores", lambda: 2)
-    monkeypatch.setattr(ahead, "cached", lambda kind: True)
-    assert ahead.start(["lean", "variational"]) is False
+    monkeypatch.setattr(ahead, "cached", lambda disp, sig: True)
+    assert ahead.start(targets) is False
     assert ahead._helper is None
-    with pytest.raises(ValueError, match=r"kernel kind = 'batch' is not allowed: use one of \('lean'"):
-        ahead.start(["batch"])
+    with pytest.raises(ValueError, match=r"kernel kinds \['batch'\] are not allowed: use \('lean'"):
+        K.compiling_ahead(["lean", "batch"])
+
+
+def test_the_helper_refuses_an_unknown_kind():
+    out = subprocess.run([sys.executable, "-m", "hunting.integrate.compile_kernels", "lean2"], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 2 and "kernel kinds ['lean2'] are not allowed" in out.stderr
 
 
 def test_the_wait_for_a_helper_is_bounded(monkeypatch):
@@ -73,10 +81,10 @@ def test_the_wait_for_a_helper_is_bounded(monkeypatch):
     (the command then compiles the kernel itself)."""
     proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
     monkeypatch.setattr(ahead, "_helper", ahead._Helper(proc, ("full",)))
-    monkeypatch.setattr(ahead, "cached", lambda kind: False)
+    monkeypatch.setattr(ahead, "cached", lambda disp, sig: False)
     t0 = time.monotonic()
-    ahead.wait_for("lean", limit=5.0)                   # not the helper's: no wait
+    ahead.wait_for("lean", None, None, limit=5.0)             # not the helper's: no wait
     assert time.monotonic() - t0 < 0.5
-    ahead.wait_for("full", limit=0.3)
+    ahead.wait_for("full", None, None, limit=0.3)
     assert 0.3 <= time.monotonic() - t0 < 6.0
     assert proc.poll() is not None and ahead._helper is None

@@ -124,7 +124,7 @@ def _kernels_ahead(cmd, args):
     kinds = cmd.kernels(args) if hasattr(cmd, "kernels") else ()
     if not kinds:
         return contextlib.nullcontext()
-    from ..integrate.ahead import compiling_ahead
+    from ..integrate._kernel import compiling_ahead
     return compiling_ahead(kinds)
 
 

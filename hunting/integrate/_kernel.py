@@ -865,8 +865,17 @@ def compiled(kind: str):
     helper and loads it from the cache."""
     disp = _DISPATCHERS[kind]
     if not disp.overloads:
-        ahead.wait_for(kind)
+        ahead.wait_for(kind, disp, KERNEL_SIG)
     return compile_for(disp, KERNEL_SIG, vectorize=kind != "lean", unroll=False)
+
+
+def compiling_ahead(kinds):
+    """A context in which a helper process compiles the uncached ones of kernels ``kinds``
+    (KINDS, in order) while this process goes on (:func:`hunting.integrate.ahead.compiling_ahead`)."""
+    bad = [k for k in kinds if k not in KINDS]
+    if bad:
+        raise ValueError(f"kernel kinds {bad} are not allowed: use {tuple(KINDS)}")
+    return ahead.compiling_ahead({k: (_DISPATCHERS[k], KERNEL_SIG) for k in kinds})
 
 
 def flow_kernel(method: int):

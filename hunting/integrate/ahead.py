@@ -4,10 +4,12 @@ On a fresh install a command's first run compiles its kernels (numba: ~9 s CPU f
 kernel, ~20 s for the variational one, with the functions they compile in turn). Its other
 work until it first integrates (imports, the preset's or the model's own functions, parsing
 data) does not depend on them. On a machine with a second core, :func:`compiling_ahead` starts
-a helper process (``python -m hunting.integrate.ahead KIND ...``) that compiles the kernels
-the command will need into numba's disk cache, in the order given, while this process goes on;
-when this process reaches a kernel the helper builds, :func:`wait_for` waits until the helper
-has cached it (or has ended) and numba loads it from the cache instead of compiling it again.
+a helper process (``python -m hunting.integrate.compile_kernels KIND ...``) that compiles the
+kernels the command will need into numba's disk cache, in the order given, while this process
+goes on; when this process reaches a kernel the helper builds, :func:`wait_for` waits until the
+helper has cached it (or has ended) and numba loads it from the cache instead of compiling it
+again. This module knows kernels only as (dispatcher, signature) pairs by kind:
+:func:`hunting.integrate._kernel.compiling_ahead` names them.
 
 Nothing starts when every kernel asked for is cached already, when this process may use one
 core only, or when the environment sets ``HUNTING_COMPILE_AHEAD=0``. Every wait is bounded
@@ -16,8 +18,7 @@ itself, as it would without a helper. The helper is stopped when the command end
 compilation outlives the command; numba writes each cache file whole (a temporary file, then
 a rename), so a stopped helper leaves no partial entry.
 
-Kinds: "lean", "variational" and "full" (:data:`hunting.integrate._kernel.KINDS`). Commands
-that run batches (:func:`hunting.integrate._batch.run_batch`) compile the batch kernel
+Commands that run batches (:func:`hunting.integrate._batch.run_batch`) compile the batch kernel
 themselves while the helper builds the integration kernel it calls.
 """
 from __future__ import annotations
@@ -28,7 +29,6 @@ import subprocess
 import sys
 import time
 
-KINDS = ("lean", "variational", "full")
 WAIT_LIMIT = 600.0          # [s] the longest this process waits for the helper before compiling itself
 POLL = 0.05                 # [s] between looks at the cache while waiting
 ENV_SWITCH = "HUNTING_COMPILE_AHEAD"
@@ -56,19 +56,10 @@ class _Helper:
                 self.proc.wait()
 
 
-def _target(kind: str):
-    """(dispatcher, signature) of kernel ``kind``."""
-    if kind not in KINDS:
-        raise ValueError(f"kernel kind = {kind!r} is not allowed: use one of {KINDS}")
-    from . import _kernel as K
-    return K._DISPATCHERS[kind], K.KERNEL_SIG
-
-
-def cached(kind: str) -> bool:
-    """Whether kernel ``kind`` is compiled in this process or in numba's disk cache for this
-    machine (numba's own index lookup). True where that cannot be told (caching off, another
-    numba): then no helper is started for it."""
-    disp, sig = _target(kind)
+def cached(disp, sig) -> bool:
+    """Whether numba dispatcher ``disp`` is compiled in this process or in numba's disk cache
+    for signature ``sig`` on this machine (numba's own index lookup). True where that cannot be
+    told (caching off, another numba): then no helper is started for it."""
     if disp.overloads:
         return True
     try:
@@ -89,25 +80,22 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
-def start(kinds) -> bool:
-    """Start a helper compiling the uncached ones of ``kinds`` (in order) unless one runs, this
-    process may use one core only or ``HUNTING_COMPILE_AHEAD=0``. Returns whether it started."""
+def start(targets: dict) -> bool:
+    """Start a helper compiling the uncached ones of ``targets`` ({kind: (dispatcher,
+    signature)}, in order) unless one runs, this process may use one core only or
+    ``HUNTING_COMPILE_AHEAD=0``. Returns whether it started."""
     global _helper
-    kinds = tuple(kinds)
-    for k in kinds:
-        if k not in KINDS:
-            raise ValueError(f"kernel kind = {k!r} is not allowed: use one of {KINDS}")
     if _helper is not None and _helper.running():
         return False
     if os.environ.get(ENV_SWITCH, "1") == "0" or _cores() < 2:
         return False
-    todo = tuple(k for k in kinds if not cached(k))
+    todo = tuple(k for k, (disp, sig) in targets.items() if not cached(disp, sig))
     if not todo:
         return False
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([root, os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep))
     try:
-        proc = subprocess.Popen([sys.executable, "-m", "hunting.integrate.ahead", *todo], env=env,
+        proc = subprocess.Popen([sys.executable, "-m", "hunting.integrate.compile_kernels", *todo], env=env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     except OSError:
         return False
@@ -123,15 +111,15 @@ def stop() -> None:
         _helper = None
 
 
-def wait_for(kind: str, limit: float = WAIT_LIMIT) -> None:
-    """Before this process compiles kernel ``kind``: if the helper builds it, wait until it is
-    cached or the helper has ended; past ``limit`` seconds stop the helper (this process then
-    compiles it itself)."""
+def wait_for(kind: str, disp, sig, limit: float = WAIT_LIMIT) -> None:
+    """Before this process compiles kernel ``kind`` (dispatcher ``disp`` for signature ``sig``):
+    if the helper builds it, wait until it is cached or the helper has ended; past ``limit``
+    seconds stop the helper (this process then compiles it itself)."""
     h = _helper
     if h is None or kind not in h.kinds:
         return
     deadline = time.monotonic() + limit
-    while h.running() and not cached(kind):
+    while h.running() and not cached(disp, sig):
         if time.monotonic() > deadline:
             stop()
             return
@@ -139,25 +127,12 @@ def wait_for(kind: str, limit: float = WAIT_LIMIT) -> None:
 
 
 @contextlib.contextmanager
-def compiling_ahead(kinds):
-    """Within the block, a helper compiles the uncached ones of ``kinds`` (see :func:`start`);
-    it is stopped when the block ends."""
-    started = start(kinds)
+def compiling_ahead(targets: dict):
+    """Within the block, a helper compiles the uncached ones of ``targets`` ({kind:
+    (dispatcher, signature)}, see :func:`start`); it is stopped when the block ends."""
+    started = start(targets)
     try:
         yield started
     finally:
         if started:
             stop()
-
-
-def _main(argv: list[str]) -> int:
-    """The helper: compile each kind named in ``argv``, in order, as a command does."""
-    from . import _kernel as K
-    for kind in argv:
-        _target(kind)
-        K.compiled(kind)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(_main(sys.argv[1:]))
