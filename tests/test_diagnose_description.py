@@ -215,3 +215,35 @@ def test_where_the_derivative_acts_is_read_from_a_reference_signal_of_t(u, on):
         return
     c = nominal_from_description(d).controller
     assert (c["kp"], c["kd"], c["ki"], c.get("derivative_on", "error")) == (50.0, 5.0, 20.0, on)
+
+
+READ_ONCE = r"""
+import json, sys
+from hunting.diagnose.model import nominal_from_description
+m = nominal_from_description(sys.argv[1])
+print(json.dumps(dict(model=m.to_dict(), sympy="sympy" in sys.modules)))
+"""
+
+
+def test_a_description_read_once_loads_from_the_cache_without_sympy(tmp_path):
+    """The nominal model read off a description is cached by the description's text and the
+    reading code: a second process loads it without importing sympy (~1.3 s of a warm
+    diagnose), with the same model; an entry that is not a nominal model is read again."""
+    import os
+    import subprocess
+    import sys
+    env = dict(os.environ, HUNTING_CACHE_DIR=str(tmp_path))
+    path = str(Path(__file__).resolve().parents[1] / "examples" / "pd_servo.json")
+
+    def read():
+        out = subprocess.run([sys.executable, "-c", READ_ONCE, path], env=env, capture_output=True, text=True,
+                             timeout=300, check=True)
+        return json.loads(out.stdout.strip().splitlines()[-1])
+    first, second = read(), read()
+    assert first["sympy"] and not second["sympy"]
+    assert second["model"] == first["model"] == nominal_from_description(path).to_dict()
+    entries = list((tmp_path / "readings").glob("*.json"))
+    assert len(entries) == 1
+    entries[0].write_text('{"plant": 1}')
+    third = read()
+    assert third["sympy"] and third["model"] == first["model"]

@@ -51,12 +51,6 @@ def files(args):
     return outputs, inputs
 
 
-def kernels(args) -> tuple[str, ...]:
-    """The kernel of the re-simulations, compiled ahead on a fresh install while this process
-    reads the data and fits the force channel."""
-    return ("lean",)
-
-
 def _parse_names(text, drop) -> dict | None:
     names = {}
     for item in (text.split(",") if text else []):

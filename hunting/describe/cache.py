@@ -6,6 +6,10 @@ stable file: its compiled functions are stored beside it in ``__pycache__``), an
 The cache directory is ``$HUNTING_CACHE_DIR`` when set, else ``$XDG_CACHE_HOME/hunting`` or
 ``~/.cache/hunting``. Files are written to a temporary name and renamed, so processes that
 compile the same model at once never read a half-written file.
+
+:func:`json_lookup` and :func:`json_store` keep other results derived from a description (e.g.
+the nominal model diagnose reads off it, :func:`hunting.diagnose.model.nominal_from_description`)
+as ``<cache>/<kind>/<digest>.json``, so a later run needs no sympy.
 """
 from __future__ import annotations
 
@@ -74,3 +78,24 @@ def _import(digest: str, path: Path, meta: dict):
     spec.loader.exec_module(mod)
     _loaded[digest] = (mod, meta)
     return mod, meta
+
+
+def json_lookup(kind: str, digest: str):
+    """The JSON value stored under ``kind``/``digest`` (:func:`json_store`), or None when there is
+    none or it cannot be read."""
+    try:
+        return json.loads((cache_root() / kind / f"{digest}.json").read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def json_store(kind: str, digest: str, value) -> bool:
+    """Store the JSON value ``value`` under ``kind``/``digest``; False (and nothing stored) when the
+    cache directory cannot be written: a cache only saves time, so that is no error."""
+    try:
+        d = cache_root() / kind
+        d.mkdir(parents=True, exist_ok=True)
+        _write(d / f"{digest}.json", json.dumps(value, allow_nan=False))
+    except (OSError, TypeError, ValueError):
+        return False
+    return True

@@ -509,11 +509,42 @@ def nominal_from_description(description, **overrides) -> NominalModel:
     >>> nominal_from_description(d).to_dict()["controller"]
     {'type': 'pid', 'kp': 39000.0, 'kd': 243.0, 'ki': 0.0, 'derivative_on': 'measurement'}
     """
+    from ..describe import cache
     from ..describe.mechanical import mechanical_parameters
     if isinstance(description, (str, Path)):
         from ..describe import read_description
         description = read_description(description)
-    return nominal_from_parameters(mechanical_parameters(description, **overrides))
+    key = _reading_key(description, overrides)
+    known = cache.json_lookup(READINGS, key) if key else None
+    if isinstance(known, dict):
+        try:
+            return NominalModel.from_dict(known)
+        except SystemDefinitionError:      # an entry not written by this code: read it again
+            pass
+    model = nominal_from_parameters(mechanical_parameters(description, **overrides))
+    if key:
+        cache.json_store(READINGS, key, model.to_dict())
+    return model
+
+
+READINGS = "readings"       # the model cache's folder of nominal models read off descriptions
+
+
+def _reading_key(description, overrides: dict) -> str | None:
+    """The digest the nominal model of ``description`` with ``overrides`` is cached under: of
+    their JSON text and of the source of the code that reads it (this module and the
+    hunting.describe package, so an upgrade or an edit never loads a reading of other code).
+    None when the description is not plain JSON data (then it is read each time)."""
+    import hashlib
+
+    from .. import describe
+    try:
+        text = json.dumps({"description": description, "overrides": overrides}, sort_keys=True, allow_nan=False)
+        sources = [Path(__file__)] + sorted(Path(describe.__file__).parent.glob("*.py"))
+        code = b"".join(f.read_bytes() for f in sources)
+    except (TypeError, ValueError, OSError):
+        return None
+    return hashlib.sha256(text.encode() + code).hexdigest()[:32]
 
 
 def nominal_from_parameters(p) -> NominalModel:
