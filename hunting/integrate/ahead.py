@@ -60,9 +60,9 @@ def cached(disp, sig) -> bool:
     """Whether numba dispatcher ``disp`` is compiled in this process or in numba's disk cache
     for signature ``sig`` on this machine (numba's own index lookup). True where that cannot be
     told (caching off, another numba): then no helper is started for it."""
-    if disp.overloads:
-        return True
     try:
+        if disp.overloads:
+            return True
         cache = disp._cache
         if not getattr(cache, "_enabled", False):
             return True
