@@ -88,3 +88,26 @@ def test_the_wait_for_a_helper_is_bounded(monkeypatch):
     ahead.wait_for("full", None, None, limit=0.3)
     assert 0.3 <= time.monotonic() - t0 < 6.0
     assert proc.poll() is not None and ahead._helper is None
+
+
+@pytest.mark.parametrize("preset, model, sets, lugre", [
+    ("table8.1-lugre", None, [], True),
+    ("table9.1", None, [], False),
+    ("table8.1-lugre", None, [("model", "switch")], False),
+    (None, "pid_lugre.json", [], True),
+    (None, "belt.json", [], False),
+    (None, "no_such_file.json", [], False),
+])
+def test_continue_compiles_the_full_kernel_ahead_for_a_lugre_contact(preset, model, sets, lugre):
+    """A LuGre branch's sensitivities run Radau: `hunting continue` has the helper compile the
+    full kernel after the variational one, read off the arguments without compiling the system
+    (an unreadable file names no kernel beyond the variational one: the command reports it)."""
+    import argparse
+    from pathlib import Path
+
+    from hunting.cli import continue_
+    from hunting.cli.systems import names_lugre
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    args = argparse.Namespace(preset=preset, model=str(examples / model) if model else None, set=sets)
+    assert names_lugre(args) is lugre
+    assert continue_.kernels(args) == (("variational", "full") if lugre else ("variational",))

@@ -13,7 +13,7 @@ from ..errors import SystemDefinitionError
 from .advice import tell
 from .boundary import UsageError, add_result_arguments, finite_float, positive_float, positive_int, result_files, \
     state_spec
-from .systems import add_system_arguments, resolve_system
+from .systems import add_system_arguments, names_lugre, resolve_system
 
 NAME = "continue"
 HELP = "follow the hunting branch in one parameter (shooting + arclength)"
@@ -48,9 +48,10 @@ files = result_files
 
 
 def kernels(args) -> tuple[str, ...]:
-    """The kernel of this command's flows, compiled ahead on a fresh install while this process
-    compiles the system and the kernels of its start."""
-    return ("variational",)
+    """The kernels of this command's flows, compiled ahead on a fresh install while this process
+    compiles the system and the kernels of its start: the variational one, and the full one
+    for a LuGre contact (its branch's sensitivities run Radau)."""
+    return ("variational", "full") if names_lugre(args) else ("variational",)
 
 
 @dataclass(frozen=True)

@@ -60,6 +60,26 @@ def add_system_arguments(p, *, model: bool = True) -> None:
                    help="override a parameter (repeatable), e.g. --set P=20 --set beta=1")
 
 
+def names_lugre(args) -> bool:
+    """Whether the system the arguments name has a LuGre contact, read without compiling it (a
+    preset's friction model with its --set overrides, a model file's friction entries); False
+    where that cannot be read (the command itself then reports what is wrong)."""
+    from ..errors import HuntingError
+    try:
+        model_file = getattr(args, "model", None)
+        if model_file:
+            from ..describe import read_description
+            friction = read_description(model_file).get("friction") or []
+            contacts = [friction] if isinstance(friction, dict) else friction
+            return any(isinstance(c, dict) and c.get("model") == "lugre" for c in contacts)
+        from ..models.presets import PRESETS, resolve_parameters
+        if args.preset not in PRESETS:
+            return False
+        return resolve_parameters(args.preset, collect_pairs(args.set, "--set")).get("model") == "lugre"
+    except (HuntingError, ValueError, OSError):
+        return False
+
+
 def resolve_system(args, *, warn: bool = True, **extra) -> SystemChoice:
     """The SystemChoice of parsed arguments; ``extra`` are overrides the command adds itself
     (e.g. the continuation parameter at its start value; a SystemDefinitionError they cause is
