@@ -11,7 +11,7 @@ events, so the report lists the functions that take the compile time (exclusive 
 functions they compile in turn). For the user model (examples/pid_lugre.json: PID + LuGre,
 4 states) a third run compiles the model alone: library caches warm, model cache empty.
 
-    python benchmarks/bench_coldstart.py                 # the main job (reproduce ch9), simulate, a user model, ...
+    python benchmarks/bench_coldstart.py                 # every scenario: simulate, event map, a user model, cycle, reproduce ch9
     python benchmarks/bench_coldstart.py --quick         # without reproduce ch9
     python benchmarks/bench_coldstart.py --repeat 3      # lowest wall time of 3 cold runs per scenario
     python benchmarks/bench_coldstart.py --root DIR      # time the hunting tree at DIR (e.g. main)
