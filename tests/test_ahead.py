@@ -76,18 +76,47 @@ def test_the_helper_refuses_an_unknown_kind():
     assert out.returncode == 2 and "kernel kinds ['lean2'] are not allowed" in out.stderr
 
 
-def test_the_wait_for_a_helper_is_bounded(monkeypatch):
-    """A helper that never caches the kernel: the wait ends at its limit and stops the helper
-    (the command then compiles the kernel itself)."""
-    proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
-    monkeypatch.setattr(ahead, "_helper", ahead._Helper(proc, ("full",)))
-    monkeypatch.setattr(ahead, "cached", lambda disp, sig: False)
-    t0 = time.monotonic()
-    ahead.wait_for("lean", None, None, limit=5.0)             # not the helper's: no wait
-    assert time.monotonic() - t0 < 0.5
-    ahead.wait_for("full", None, None, limit=0.3)
-    assert 0.3 <= time.monotonic() - t0 < 6.0
-    assert proc.poll() is not None and ahead._helper is None
+def test_the_kernel_lock_excludes_a_second_process_and_its_wait_is_bounded(tmp_path):
+    """Kernel compiles hold an exclusive lock on the kernels' cache directory: while another
+    process holds it a compile waits, and past the limit it goes on without it."""
+    from hunting.integrate import _kernel as K
+    disp = K._DISPATCHERS["lean"]
+    path = os.path.join(disp._cache._cache_path, ahead.LOCK_NAME)
+    holder = subprocess.Popen([sys.executable, "-c", "import fcntl, os, sys, time\n"
+                               f"fd = os.open({path!r}, os.O_RDWR | os.O_CREAT)\n"
+                               "fcntl.flock(fd, fcntl.LOCK_EX)\nprint('held', flush=True)\ntime.sleep(3)\n"],
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        t0 = time.monotonic()
+        with ahead.kernel_lock(disp, limit=0.3):
+            waited = time.monotonic() - t0
+        assert 0.3 <= waited < 2.0                       # gave up at the limit
+        with ahead.kernel_lock(disp, limit=30.0):
+            waited = time.monotonic() - t0
+        assert 2.0 <= waited < 10.0                      # took it once the holder ended
+    finally:
+        holder.kill()
+        holder.wait()
+
+
+def test_a_stopped_helper_finishes_its_kernel_and_starts_no_other(tmp_path):
+    """Closing the helper's standard input tells it to stop after the kernel it compiles (a
+    kill between numba's index and data writes could leave an entry naming another file)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    proc = subprocess.Popen([sys.executable, "-m", "hunting.integrate.compile_kernels", "lean", "full"], env=env,
+                            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    time.sleep(4.0)                                  # imports done, the lean kernel compiling
+    proc.stdin.close()
+    assert proc.wait(timeout=300) == 0, proc.stderr.read()
+    names = " ".join(os.listdir(tmp_path / "numba")) if (tmp_path / "numba").exists() else ""
+    assert "integrate" in names                      # the lean kernel (begun at once) was finished
+    from hunting.integrate import _kernel as K
+    lean = subprocess.run([sys.executable, "-c", "from hunting.integrate import ahead, _kernel as K\n"
+                           "print(ahead.cached(K._DISPATCHERS['lean'], K.KERNEL_SIG), "
+                           "ahead.cached(K._DISPATCHERS['full'], K.KERNEL_SIG))"],
+                          env=env, capture_output=True, text=True, timeout=120, check=True).stdout.split()
+    assert lean == ["True", "False"] and K.KINDS
 
 
 @pytest.mark.parametrize("preset, model, sets, lugre", [
@@ -100,8 +129,8 @@ def test_the_wait_for_a_helper_is_bounded(monkeypatch):
 ])
 def test_continue_compiles_the_full_kernel_ahead_for_a_lugre_contact(preset, model, sets, lugre):
     """A LuGre branch's sensitivities run Radau: `hunting continue` has the helper compile the
-    full kernel after the variational one, read off the arguments without compiling the system
-    (an unreadable file names no kernel beyond the variational one: the command reports it)."""
+    full kernel after the lean and variational ones, read off the arguments without compiling
+    the system (an unreadable file names none beyond those: the command reports it)."""
     import argparse
     from pathlib import Path
 
@@ -110,4 +139,17 @@ def test_continue_compiles_the_full_kernel_ahead_for_a_lugre_contact(preset, mod
     examples = Path(__file__).resolve().parents[1] / "examples"
     args = argparse.Namespace(preset=preset, model=str(examples / model) if model else None, set=sets)
     assert names_lugre(args) is lugre
-    assert continue_.kernels(args) == (("variational", "full") if lugre else ("variational",))
+    assert continue_.kernels(args) == (("lean", "variational", "full") if lugre else ("lean", "variational"))
+
+
+def test_a_model_file_that_is_not_a_mapping_names_no_lugre(tmp_path):
+    """A model file holding a JSON list: the kernel hint says no LuGre (the command itself then
+    reports the file), never an unexpected error."""
+    import argparse
+
+    from hunting.cli.systems import names_lugre
+    path = tmp_path / "list.json"
+    path.write_text("[1, 2]")
+    assert names_lugre(argparse.Namespace(preset=None, model=str(path), set=[])) is False
+    path.write_text('{"friction": 3}')
+    assert names_lugre(argparse.Namespace(preset=None, model=str(path), set=[])) is False

@@ -48,10 +48,10 @@ files = result_files
 
 
 def kernels(args) -> tuple[str, ...]:
-    """The kernels of this command's flows, compiled ahead on a fresh install while this process
-    compiles the system and the kernels of its start: the variational one, and the full one
-    for a LuGre contact (its branch's sensitivities run Radau)."""
-    return ("variational", "full") if names_lugre(args) else ("variational",)
+    """The kernels this command runs, in order (its start's simulation, the flows', and the
+    full one for a LuGre contact, whose branch's sensitivities run Radau), compiled ahead on a
+    fresh install while this process compiles the system."""
+    return ("lean", "variational", "full") if names_lugre(args) else ("lean", "variational")
 
 
 @dataclass(frozen=True)

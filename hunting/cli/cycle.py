@@ -42,9 +42,9 @@ files = result_files
 
 
 def kernels(args) -> tuple[str, ...]:
-    """The kernel of this command's flows, compiled ahead on a fresh install while this process
-    compiles the model and the lean kernel of its transient simulation."""
-    return ("variational",)
+    """The kernels this command runs, in order (the transient simulation's, the flows'),
+    compiled ahead on a fresh install while this process compiles the system."""
+    return ("lean", "variational")
 
 
 def run(args, results) -> int:

@@ -69,9 +69,11 @@ def names_lugre(args) -> bool:
         model_file = getattr(args, "model", None)
         if model_file:
             from ..describe import read_description
-            friction = read_description(model_file).get("friction") or []
+            description = read_description(model_file)
+            friction = (description.get("friction") or []) if isinstance(description, dict) else []
             contacts = [friction] if isinstance(friction, dict) else friction
-            return any(isinstance(c, dict) and c.get("model") == "lugre" for c in contacts)
+            return isinstance(contacts, list) and any(isinstance(c, dict) and c.get("model") == "lugre"
+                                                      for c in contacts)
         from ..models.presets import PRESETS, resolve_parameters
         if args.preset not in PRESETS:
             return False

@@ -519,7 +519,7 @@ def nominal_from_description(description, **overrides) -> NominalModel:
     if isinstance(known, dict):
         try:
             return NominalModel.from_dict(known)
-        except SystemDefinitionError:      # an entry not written by this code: read it again
+        except Exception:  # noqa: BLE001 -- an entry this code did not write: read the description again
             pass
     model = nominal_from_parameters(mechanical_parameters(description, **overrides))
     if key:

@@ -861,12 +861,14 @@ def compiled(kind: str):
     loop, DOP853 with and without sensitivities and Radau, both kernels in one process called
     in alternation: 0.98-1.01 times the run time, bit-identical states).
 
-    Where a helper process compiles it (:mod:`hunting.integrate.ahead`), this waits for the
-    helper and loads it from the cache."""
+    The compile holds the kernels' cache lock (:func:`hunting.integrate.ahead.kernel_lock`):
+    where a helper process compiles it meanwhile, this waits for it and loads it from the
+    cache."""
     disp = _DISPATCHERS[kind]
     if not disp.overloads:
-        ahead.wait_for(kind, disp, KERNEL_SIG)
-    return compile_for(disp, KERNEL_SIG, vectorize=kind != "lean", unroll=False)
+        with ahead.kernel_lock(disp):
+            compile_for(disp, KERNEL_SIG, vectorize=kind != "lean", unroll=False)
+    return disp
 
 
 def compiling_ahead(kinds):

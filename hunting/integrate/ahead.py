@@ -1,25 +1,29 @@
 """Compiling the integration kernels in a second process while this one does the rest.
 
 On a fresh install a command's first run compiles its kernels (numba: ~9 s CPU for the lean
-kernel, ~20 s for the variational one, with the functions they compile in turn). Its other
+kernel, ~15-20 s for the variational one, with the functions they compile in turn). Its other
 work until it first integrates (imports, the preset's or the model's own functions, parsing
 data) does not depend on them. On a machine with a second core, :func:`compiling_ahead` starts
 a helper process (``python -m hunting.integrate.compile_kernels KIND ...``) that compiles the
-kernels the command will need into numba's disk cache, in the order given, while this process
-goes on; when this process reaches a kernel the helper builds, :func:`wait_for` waits until the
-helper has cached it (or has ended) and numba loads it from the cache instead of compiling it
-again. This module knows kernels only as (dispatcher, signature) pairs by kind:
+kernels the command will run into numba's disk cache, in the order it runs them, while this
+process goes on. This module knows kernels only as (dispatcher, signature) pairs by kind:
 :func:`hunting.integrate._kernel.compiling_ahead` names them.
 
-Nothing starts when every kernel asked for is cached already, when this process may use one
-core only, or when the environment sets ``HUNTING_COMPILE_AHEAD=0``. Every wait is bounded
-(:data:`WAIT_LIMIT`): past it the helper is stopped and this process compiles the kernel
-itself, as it would without a helper. The helper is stopped when the command ends, so no
-compilation outlives the command; numba writes each cache file whole (a temporary file, then
-a rename), so a stopped helper leaves no partial entry.
+Every kernel compile, in any process, holds :func:`kernel_lock`, an exclusive lock on a file in
+the kernels' numba cache directory. The kernels share their compiled helpers (steppers, guards,
+right-hand sides) and numba's on-disk index files, which numba rewrites without a lock and
+writes before the data file they name: two processes compiling different specializations of one
+function at once can give two entries the same data file, and a process reading an index entry
+before its data is written loads nothing or an older file. Under the lock a command that reaches
+a kernel the helper is compiling waits for it, then numba loads it from the cache. (The other
+functions a command compiles meanwhile, the models' and the batch kernel, share nothing with the
+kernels.)
 
-Commands that run batches (:func:`hunting.integrate._batch.run_batch`) compile the batch kernel
-themselves while the helper builds the integration kernel it calls.
+Nothing starts when every kernel asked for is cached already, when this process may use one
+core only, or when the environment sets ``HUNTING_COMPILE_AHEAD=0``. Every wait for the lock is
+bounded (:data:`WAIT_LIMIT`; past it the process compiles without it). When the command ends
+the helper is told to stop (its standard input closes, also when this process dies): it
+finishes the kernel it is compiling, so numba's cache stays whole, and starts no other.
 """
 from __future__ import annotations
 
@@ -29,31 +33,13 @@ import subprocess
 import sys
 import time
 
-WAIT_LIMIT = 600.0          # [s] the longest this process waits for the helper before compiling itself
-POLL = 0.05                 # [s] between looks at the cache while waiting
+WAIT_LIMIT = 600.0          # [s] the longest a process waits for the kernel lock
+POLL = 0.05                 # [s] between attempts to take it
 ENV_SWITCH = "HUNTING_COMPILE_AHEAD"
+LOCK_NAME = "hunting-kernels.lock"
 
-_helper: _Helper | None = None      # the running helper of this process, if any
-
-
-class _Helper:
-    """A started helper process: the kinds it compiles, in order."""
-
-    def __init__(self, proc: subprocess.Popen, kinds: tuple[str, ...]):
-        self.proc = proc
-        self.kinds = kinds
-
-    def running(self) -> bool:
-        return self.proc.poll() is None
-
-    def stop(self) -> None:
-        if self.running():
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=5.0)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+_helper: subprocess.Popen | None = None     # the running helper of this process, if any
+_stopped: list = []                          # helpers told to stop that may still finish a kernel
 
 
 def cached(disp, sig) -> bool:
@@ -73,6 +59,37 @@ def cached(disp, sig) -> bool:
         return True
 
 
+@contextlib.contextmanager
+def kernel_lock(disp, limit: float = WAIT_LIMIT):
+    """Hold the exclusive lock on the kernels' numba cache directory (that of dispatcher
+    ``disp``) while compiling a kernel. Taken by polling, at most ``limit`` seconds; where it
+    cannot be taken (no cache directory, no ``fcntl``, the limit passed) the block runs
+    without it, as numba does."""
+    fd = None
+    try:
+        import fcntl
+        path = os.path.join(disp._cache._cache_path, LOCK_NAME)
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        deadline = time.monotonic() + limit
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if time.monotonic() > deadline:
+                    raise TimeoutError from None
+                time.sleep(POLL)
+    except Exception:  # noqa: BLE001 -- no lock to be had: compile as numba does without one
+        if fd is not None:
+            os.close(fd)
+        fd = None
+    try:
+        yield
+    finally:
+        if fd is not None:
+            os.close(fd)            # closing the descriptor releases the lock
+
+
 def _cores() -> int:
     try:
         return len(os.sched_getaffinity(0))
@@ -80,56 +97,55 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
+def _running(proc) -> bool:
+    return proc is not None and proc.poll() is None
+
+
 def start(targets: dict) -> bool:
     """Start a helper compiling the uncached ones of ``targets`` ({kind: (dispatcher,
-    signature)}, in order) unless one runs, this process may use one core only or
-    ``HUNTING_COMPILE_AHEAD=0``. Returns whether it started."""
+    signature)}, in order) unless a helper of this process still runs, this process may use one
+    core only or ``HUNTING_COMPILE_AHEAD=0``. Returns whether it started."""
     global _helper
-    if _helper is not None and _helper.running():
+    _stopped[:] = [p for p in _stopped if _running(p)]        # reaped once they end
+    if _running(_helper) or _stopped:
         return False
     if os.environ.get(ENV_SWITCH, "1") == "0" or _cores() < 2:
         return False
     todo = tuple(k for k, (disp, sig) in targets.items() if not cached(disp, sig))
     if not todo:
         return False
+    # -P: the working directory is not searched first (a ./hunting there would shadow this
+    # one); the package's root goes on the path unless it is a site directory, there already
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([root, os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep))
+    env = dict(os.environ)
+    if os.path.basename(root) not in ("site-packages", "dist-packages"):
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)
+    import numba
+    if numba.config.CACHE_DIR:          # the cache this process uses, even if set after numba's import
+        env["NUMBA_CACHE_DIR"] = numba.config.CACHE_DIR
     try:
-        proc = subprocess.Popen([sys.executable, "-m", "hunting.integrate.compile_kernels", *todo], env=env,
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        _helper = subprocess.Popen([sys.executable, "-P", "-m", "hunting.integrate.compile_kernels", *todo],
+                                   env=env, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
     except OSError:
         return False
-    _helper = _Helper(proc, todo)
     return True
 
 
 def stop() -> None:
-    """Stop this process's helper if it still runs."""
+    """Tell this process's helper to end after the kernel it is compiling."""
     global _helper
     if _helper is not None:
-        _helper.stop()
+        with contextlib.suppress(OSError):
+            _helper.stdin.close()
+        _stopped.append(_helper)
         _helper = None
-
-
-def wait_for(kind: str, disp, sig, limit: float = WAIT_LIMIT) -> None:
-    """Before this process compiles kernel ``kind`` (dispatcher ``disp`` for signature ``sig``):
-    if the helper builds it, wait until it is cached or the helper has ended; past ``limit``
-    seconds stop the helper (this process then compiles it itself)."""
-    h = _helper
-    if h is None or kind not in h.kinds:
-        return
-    deadline = time.monotonic() + limit
-    while h.running() and not cached(disp, sig):
-        if time.monotonic() > deadline:
-            stop()
-            return
-        time.sleep(POLL)
 
 
 @contextlib.contextmanager
 def compiling_ahead(targets: dict):
     """Within the block, a helper compiles the uncached ones of ``targets`` ({kind:
-    (dispatcher, signature)}, see :func:`start`); it is stopped when the block ends."""
+    (dispatcher, signature)}, see :func:`start`); it is told to stop when the block ends."""
     started = start(targets)
     try:
         yield started

@@ -1,10 +1,24 @@
 """The helper process of :mod:`hunting.integrate.ahead`: ``python -m
 hunting.integrate.compile_kernels KIND ...`` compiles each integration kernel named (one of
 :data:`hunting.integrate._kernel.KINDS`), in order, into numba's disk cache, as a command
-would (:func:`hunting.integrate._kernel.compiled`)."""
+would (:func:`hunting.integrate._kernel.compiled`, under the kernels' cache lock). When its
+standard input closes (the command that started it has ended or stopped it) it finishes the
+kernel it is compiling and ends: numba writes a kernel's index entry before its data file, so a
+helper killed in between could leave an entry naming another kernel's file."""
 from __future__ import annotations
 
+import contextlib
 import sys
+import threading
+
+
+_stop = threading.Event()
+
+
+def _watch_stdin() -> None:
+    with contextlib.suppress(OSError, ValueError):
+        sys.stdin.read()
+    _stop.set()
 
 
 def main(argv: list[str]) -> int:
@@ -14,7 +28,10 @@ def main(argv: list[str]) -> int:
     if bad:
         print(f"kernel kinds {bad} are not allowed: use {tuple(K.KINDS)}", file=sys.stderr)
         return 2
+    threading.Thread(target=_watch_stdin, daemon=True).start()
     for kind in argv:
+        if _stop.is_set():
+            break
         K.compiled(kind)
     return 0
 
