@@ -16,7 +16,9 @@ giving the standard uncertainty of parameters computed from them, and ``refine_s
 other starting values of hyper-parameters the search holds fixed), ``UNITS`` (of the parameters), ``sentence(p,
 increments, model)`` (the finding in words), ``untestable(kin, model)`` (why a record cannot test
 it), ``EXCLUDES`` (causes it cannot be combined with), ``NOISE_FED`` (its regressor is made of
-measured derivatives: judged also along a noise-free instrument trajectory). Adding a cause is
+measured derivatives: judged also along a noise-free instrument trajectory), ``JUDGED_FIRST``
+(an own-evidence cause whose evidence reads only the measured records, judged before the other
+channels so that their re-simulations run on its extension). Adding a cause is
 adding a module and listing it here."""
 from ..model import NominalModel
 from ...models.friction import DirectionalCurve

@@ -34,6 +34,12 @@ from ._words import _count
 NAME = "saturation"
 DESCRIPTION = "controller output saturation missing from the model"
 CHANNEL = "own"
+# judged before the other channels: its evidence reads only the measured output, and a loop that
+# saturates re-simulated without it makes every loop fit chase the missing limit (reporting18
+# d0353: a viscous change cut the unsaturated loop's position error by 81 % / 59 % and was named
+# beside the saturation; d0635: LuGre bristles behind a saturation were judged on a loop whose
+# controller output was 80 times the machine's)
+JUDGED_FIRST = True
 FAMILY = "actuator"
 UNITS = {"saturation": ""}
 MIN_AT_BOUND = 5
