@@ -310,14 +310,15 @@ def test_blind_subset_parameters_target(blind_subset):
     assert s["params"][0] >= report.TARGETS["params"], _bad_parameters(rows)
 
 
-@pytest.mark.parametrize("index, expected", [(353, ["saturation"]), (635, ["saturation", "presliding"])])
-def test_saturation_is_judged_before_the_loop_fits(tmp_path, index, expected):
-    """Two saturated loops with too few sliding samples for the force channel (reporting18, a
-    development set since): re-simulated without the limit their machine has, a viscous change
-    cut d0353's position error by 81 % / 59 % and was named beside the saturation, and d0635's
-    LuGre bristles (a reversal effect) were judged on a loop whose output was 80 times the
-    machine's and missed. Judged first, the saturation is alone on d0353 and the bristles are
-    found on d0635."""
+@pytest.mark.parametrize("index, expected", [(353, ["saturation"]), (635, ["saturation", "presliding"]),
+                                             (586, ["presliding", "quantization"])])
+def test_recorded_signal_causes_are_judged_before_the_loop_fits(tmp_path, index, expected):
+    """Loops whose saturation or DAC steps the model lacks (reporting18, a development set
+    since). Re-simulated without the limit their machine has, a viscous change cut d0353's
+    position error by 81 % / 59 % and was named beside the saturation, and d0635's LuGre bristles
+    (a reversal effect) were judged on a loop whose output was 80 times the machine's and missed;
+    d0586's bristles were missed beside its DAC's steps. Judged first, the saturation is alone on
+    d0353 and the bristles are found on d0635 and d0586."""
     generate.write("reporting18", tmp_path, indices=[index], progress=False)
     r = run.judge_hunting(tmp_path / f"d{index:04d}")
     assert [c["name"] for c in r["causes"]] == expected, r["causes"]

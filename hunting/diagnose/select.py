@@ -20,10 +20,11 @@ The rule (stated in every report, :data:`RULE`):
   (:mod:`hunting.diagnose.force`, :mod:`hunting.diagnose.stats`);
 - causes with their own evidence (``CHANNEL = "own"``: dwell, saturation, quantization) bring a
   statistic with its p-value and a validation metric of their own (module docstrings); the same
-  alpha and min_gain decide. Saturation (``JUDGED_FIRST``: its evidence reads only the measured
-  controller output) is judged before every other channel: where it holds on the nominal model,
-  the others are judged on its extension, so that their re-simulations run the loop the machine
-  has; where it fails there, it is judged again in its place, on their extension;
+  alpha and min_gain decide. Saturation and quantization (``JUDGED_FIRST``: their evidence reads
+  only the recorded signals) are judged before every other channel: where one holds on the
+  nominal model, the others are judged on its extension, so that their re-simulations run the
+  loop the machine has; where it fails there, it is judged again in its place, on their
+  extension;
 - stick-channel causes (``CHANNEL = "stick"``: presliding) are judged on the samples where the
   (force-extended) model says the mass sticks: a chi-square test of the motion there against the
   sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
@@ -65,8 +66,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "the other noise-fed causes', explains at least {reference_gain:.1%} of it), dropping it grows the validation RMS by at least "
         "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much and by {swap_share:.0%} of the nominal model's validation residual, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by both, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%} (saturation, whose evidence reads only the measured "
-        "output, first: where it holds on the nominal model every other channel is judged on its extension, and where it "
-        "fails there it is judged again last, on theirs); presliding, where no creep shows at rest, also "
+        "output, and quantization, whose evidence reads only the recorded signals, first: where one holds on the nominal "
+        "model every other channel is judged on its extension, and where it fails there it is judged again last, on "
+        "theirs); presliding, where no creep shows at rest, also "
         "when LuGre bristles fitted on the fitting record's re-simulated loop cut both records' position error by at "
         "least {loop_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
         "that fitted on the fitting record's loop cuts its position error most, when it cuts both records' by at least "
@@ -250,10 +252,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     can_sim = _can_simulate(fit, validate, model)
     from .resimulate import resolution_of
     res = model.resolution if model.resolution is not None else resolution_of(fit.q)
-    # a cause whose evidence reads only the measured records (saturation) is judged first: when it
-    # holds on the nominal model, every other channel's re-simulation runs the loop the machine
-    # has; when it fails there (its gain can need the others: reporting18 d0544, a level 40 % off
-    # beside the saturation), it is judged again in its place, on their extension
+    # causes whose evidence reads only the measured records (saturation, quantization) are judged
+    # first: where one holds on the nominal model, every other channel's re-simulation runs the
+    # loop the machine has; where it fails there (its gain can need the others: reporting18 d0544,
+    # a level 40 % off beside the saturation), it is judged again in its place, on their extension
     result, rejected, nominal, ticked = [], [], model, set()
     for name in [n for n in own_names if getattr(CAUSES[n], "JUDGED_FIRST", False)]:
         tick(name)

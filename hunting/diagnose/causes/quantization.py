@@ -15,6 +15,10 @@ from ._words import _q
 NAME = "quantization"
 DESCRIPTION = "controller output (DAC) or sensor quantization different from the model's"
 CHANNEL = "own"
+# judged before the other channels (as saturation): its evidence reads only the recorded signals,
+# and LuGre bristles behind a DAC's steps were judged on a loop without them and missed
+# (reporting18 d0586; found when judged on the quantized loop)
+JUDGED_FIRST = True
 FAMILY = "actuator"
 UNITS = {"output_resolution": "", "sensor_resolution": "m"}
 
