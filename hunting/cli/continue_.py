@@ -48,10 +48,12 @@ files = result_files
 
 
 def kernels(args) -> tuple[str, ...]:
-    """The kernels this command runs, in order (its start's simulation, the flows', and the
-    full one for a LuGre contact, whose branch's sensitivities run Radau), compiled ahead on a
-    fresh install while this process compiles the system."""
-    return ("lean", "variational", "full") if names_lugre(args) else ("lean", "variational")
+    """The kernels this command runs, compiled ahead on a fresh install while this process
+    compiles the system: the flows' variational kernel (which also runs the start's simulation
+    until the lean kernel, compiled last, is cached:
+    :func:`hunting.integrate._kernel.plain_kind`), and the full one for a LuGre contact, whose
+    branch's sensitivities run Radau."""
+    return ("variational", "full", "lean") if names_lugre(args) else ("variational", "lean")
 
 
 @dataclass(frozen=True)

@@ -887,11 +887,30 @@ def flow_kernel(method: int):
 
 
 def kernel_for(method: int):
-    """The compiled kernel that runs ``method`` (METHOD_*) without sensitivities: the lean
-    kernel for DOP853, else the full one (flows call :func:`flow_kernel` with or without
-    sensitivities: without them a flow runs as fast on either, 149 vs 161 us per period of
-    table 9.1)."""
-    return compiled("full" if calls_jacobian(method) else "lean")
+    """The compiled kernel that runs ``method`` (METHOD_*) without sensitivities: the full one
+    for DP5 and Radau; for DOP853 the lean kernel, or the variational one standing in for it
+    while the lean one is not compiled (:func:`plain_kind`)."""
+    return compiled("full" if calls_jacobian(method) else plain_kind())
+
+
+def plain_kind() -> str:
+    """The kernel kind that runs DOP853 without sensitivities in this process: "lean", or
+    "variational" where the lean kernel is neither compiled nor cached and the variational one
+    is, or a helper compiles it before the lean one (a command that shoots or continues on a
+    fresh install, :func:`compiling_ahead` with ("variational", "lean")). The variational
+    kernel gives bit-identical states without sensitivities but runs plain simulations ~15-20 %
+    slower (table 9.1 and a 4-state PID + LuGre loop, both kernels in one process called in
+    alternation); standing in, it saves that command the lean kernel's compile (~9 s CPU),
+    which the helper does after the variational one, for the next command."""
+    lean, var = _DISPATCHERS["lean"], _DISPATCHERS["variational"]
+    if lean.overloads or ahead.cached(lean, KERNEL_SIG):
+        return "lean"
+    if var.overloads or ahead.cached(var, KERNEL_SIG):
+        return "variational"
+    order = ahead.queued()
+    if "variational" in order and order.index("variational") < (order.index("lean") if "lean" in order else len(order)):
+        return "variational"
+    return "lean"
 
 
 def calls_jacobian(method: int) -> bool:

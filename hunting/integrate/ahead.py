@@ -40,6 +40,7 @@ LOCK_NAME = "hunting-kernels.lock"
 
 _helper: subprocess.Popen | None = None     # the running helper of this process, if any
 _stopped: list = []                          # helpers told to stop that may still finish a kernel
+_queue: tuple = ()                           # the kinds the running helper was given, in order
 
 
 def cached(disp, sig) -> bool:
@@ -105,7 +106,7 @@ def start(targets: dict) -> bool:
     """Start a helper compiling the uncached ones of ``targets`` ({kind: (dispatcher,
     signature)}, in order) unless a helper of this process still runs, this process may use one
     core only or ``HUNTING_COMPILE_AHEAD=0``. Returns whether it started."""
-    global _helper
+    global _helper, _queue
     _stopped[:] = [p for p in _stopped if _running(p)]        # reaped once they end
     if _running(_helper) or _stopped:
         return False
@@ -129,17 +130,23 @@ def start(targets: dict) -> bool:
                                    stderr=subprocess.DEVNULL)
     except OSError:
         return False
+    _queue = todo
     return True
+
+
+def queued() -> tuple:
+    """The kinds this process's running helper compiles, in order (empty without one)."""
+    return _queue if _running(_helper) else ()
 
 
 def stop() -> None:
     """Tell this process's helper to end after the kernel it is compiling."""
-    global _helper
+    global _helper, _queue
     if _helper is not None:
         with contextlib.suppress(OSError):
             _helper.stdin.close()
         _stopped.append(_helper)
-        _helper = None
+        _helper, _queue = None, ()
 
 
 @contextlib.contextmanager

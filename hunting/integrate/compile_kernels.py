@@ -10,6 +10,9 @@ from __future__ import annotations
 import contextlib
 import sys
 import threading
+import time
+
+from .ahead import POLL
 
 
 _stop = threading.Event()
@@ -29,9 +32,13 @@ def main(argv: list[str]) -> int:
         print(f"kernel kinds {bad} are not allowed: use {tuple(K.KINDS)}", file=sys.stderr)
         return 2
     threading.Thread(target=_watch_stdin, daemon=True).start()
-    for kind in argv:
+    for i, kind in enumerate(argv):
         if _stop.is_set():
             break
+        if i:
+            # a pause with the lock free: a command waiting to load the kernel just compiled
+            # (it polls every POLL) takes the lock before this compiles the next one
+            time.sleep(3 * POLL)
         K.compiled(kind)
     return 0
 
