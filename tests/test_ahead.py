@@ -41,6 +41,22 @@ def _cold_cli(tmp_path, switch: str, *args) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+LOCK_FREE_LOAD = r"""
+import contextlib
+from hunting.integrate import ahead, _kernel as K
+@contextlib.contextmanager
+def refused(disp, limit=0):
+    raise RuntimeError("the kernel lock was taken")
+    yield
+ahead.kernel_lock = refused
+print("loaded" if K.compiled("variational").overloads else "missing")
+try:
+    K.compiled("lean")
+except RuntimeError:
+    print("locked")
+"""
+
+
 def _compile_kernels(tmp_path, *kinds):
     """Compile kernels ``kinds`` into the test's fresh numba cache with the helper's program."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
@@ -60,6 +76,12 @@ def test_the_variational_kernel_stands_in_for_the_lean_one_on_a_cold_cycle(tmp_p
     states)."""
     args = ("cycle", "--model", str(ROOT / "examples" / "belt.json"))
     _compile_kernels(tmp_path, "variational")
+    # a whole cache entry loads without the kernel lock (a helper compiling another kernel may
+    # hold it for seconds); a kernel not in the cache compiles under it
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    out = subprocess.run([sys.executable, "-c", LOCK_FREE_LOAD], env=env, capture_output=True, text=True,
+                         timeout=600)
+    assert out.returncode == 0 and out.stdout.split() == ["loaded", "locked"], out.stdout + out.stderr
     res = _cold_cli(tmp_path, "0", *args)
     assert res["code"] == 0, res["out"]
     assert not [q for q in res["compiled"] if "integrate_kernel" in q], res["compiled"]

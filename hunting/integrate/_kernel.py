@@ -861,13 +861,14 @@ def compiled(kind: str):
     loop, DOP853 with and without sensitivities and Radau, both kernels in one process called
     in alternation: 0.98-1.01 times the run time, bit-identical states).
 
-    The compile holds the kernels' cache lock (:func:`hunting.integrate.ahead.kernel_lock`):
-    where a helper process compiles it meanwhile, this waits for it and loads it from the
-    cache."""
+    A kernel whose cache entry is whole loads without a lock (:func:`hunting.integrate.ahead.load`);
+    a compile holds the kernels' cache lock (:func:`hunting.integrate.ahead.kernel_lock`): where
+    a helper process compiles this kernel meanwhile, it waits for it and loads it from the cache."""
     disp = _DISPATCHERS[kind]
-    if not disp.overloads:
+    if not disp.overloads and not ahead.load(disp, KERNEL_SIG):
         with ahead.kernel_lock(disp):
             compile_for(disp, KERNEL_SIG, vectorize=kind != "lean", unroll=False)
+    disp.disable_compile()
     return disp
 
 

@@ -43,6 +43,32 @@ _stopped: list = []                          # helpers told to stop that may sti
 _queue: tuple = ()                           # the kinds the running helper was given, in order
 
 
+def load(disp, sig) -> bool:
+    """Load dispatcher ``disp``'s compiled ``sig`` from numba's disk cache into this process, as
+    numba's own compile does on a cache hit (without taking the kernel lock: a cache entry is
+    whole once numba has written it, index and data each by an atomic rename, and loading writes
+    nothing; a helper compiling another kernel meanwhile holds the lock for seconds). Returns
+    whether it did: False where the entry is missing, not yet written or unreadable, and the
+    caller then compiles under :func:`kernel_lock` (numba loads it there if it appeared)."""
+    try:
+        if disp.overloads:
+            return True
+        from numba.core.compiler_lock import global_compiler_lock
+        cache = disp._cache
+        if not getattr(cache, "_enabled", False):
+            return False
+        with global_compiler_lock:
+            disp.targetctx.refresh()
+            cres = cache.load_overload(sig, disp.targetctx)
+            if cres is None or cres.objectmode:
+                return False
+            disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+            disp.add_overload(cres)
+        return True
+    except Exception:  # noqa: BLE001 -- numba internals: when they differ, compile under the lock instead
+        return False
+
+
 def cached(disp, sig) -> bool:
     """Whether numba dispatcher ``disp`` is compiled in this process or in numba's disk cache
     for signature ``sig`` on this machine (numba's own index lookup). True where that cannot be
