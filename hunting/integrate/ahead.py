@@ -15,7 +15,9 @@ right-hand sides) and numba's on-disk index files, which numba rewrites without 
 writes before the data file they name: two processes compiling different specializations of one
 function at once can give two entries the same data file, and a process reading an index entry
 before its data is written loads nothing or an older file. Under the lock a command that reaches
-a kernel the helper is compiling waits for it, then numba loads it from the cache. (The other
+a kernel the helper is compiling waits for it, then numba loads it from the cache; a kernel whose
+cache entry is whole loads without the lock (:func:`load`), so a command does not wait for a
+helper compiling another kernel. (The other
 functions a command compiles meanwhile, the models' and the batch kernel, share nothing with the
 kernels.)
 
