@@ -45,6 +45,16 @@ _stopped: list = []                          # helpers told to stop that may sti
 _queue: tuple = ()                           # the kinds the running helper was given, in order
 
 
+def _disk_cache(disp):
+    """Dispatcher ``disp``'s numba disk cache, its target refreshed for a lookup; None where
+    caching is off. May raise where numba's internals differ (callers catch it)."""
+    cache = disp._cache
+    if not getattr(cache, "_enabled", False):
+        return None
+    disp.targetctx.refresh()
+    return cache
+
+
 def load(disp, sig) -> bool:
     """Load dispatcher ``disp``'s compiled ``sig`` from numba's disk cache into this process, as
     numba's own compile does on a cache hit (without taking the kernel lock: a cache entry is
@@ -52,16 +62,13 @@ def load(disp, sig) -> bool:
     nothing; a helper compiling another kernel meanwhile holds the lock for seconds). Returns
     whether it did: False where the entry is missing, not yet written or unreadable, and the
     caller then compiles under :func:`kernel_lock` (numba loads it there if it appeared)."""
+    if disp.overloads:
+        return True
+    from numba.core.compiler_lock import global_compiler_lock
     try:
-        if disp.overloads:
-            return True
-        from numba.core.compiler_lock import global_compiler_lock
-        cache = disp._cache
-        if not getattr(cache, "_enabled", False):
-            return False
         with global_compiler_lock:
-            disp.targetctx.refresh()
-            cres = cache.load_overload(sig, disp.targetctx)
+            cache = _disk_cache(disp)
+            cres = None if cache is None else cache.load_overload(sig, disp.targetctx)
             if cres is None or cres.objectmode:
                 return False
             disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
@@ -75,15 +82,11 @@ def cached(disp, sig) -> bool:
     """Whether numba dispatcher ``disp`` is compiled in this process or in numba's disk cache
     for signature ``sig`` on this machine (numba's own index lookup). True where that cannot be
     told (caching off, another numba): then no helper is started for it."""
+    if disp.overloads:
+        return True
     try:
-        if disp.overloads:
-            return True
-        cache = disp._cache
-        if not getattr(cache, "_enabled", False):
-            return True
-        disp.targetctx.refresh()
-        key = cache._index_key(sig, disp.targetctx.codegen())
-        return key in cache._cache_file._load_index()
+        cache = _disk_cache(disp)
+        return cache is None or cache._index_key(sig, disp.targetctx.codegen()) in cache._cache_file._load_index()
     except Exception:  # noqa: BLE001 -- numba internals: when they differ, behave as without a helper
         return True
 
