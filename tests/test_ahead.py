@@ -71,9 +71,8 @@ def _compile_kernels(tmp_path, *kinds):
 def test_the_variational_kernel_stands_in_for_the_lean_one_on_a_cold_cycle(tmp_path):
     """A fresh install whose cache holds the variational kernel only (the helper of `hunting
     cycle` compiles it first): the command runs its transient simulation on it and compiles no
-    integrate_kernel in its own process, only the model's functions. Once the lean kernel is
-    cached too, the command runs on it and prints the same result (the two give bit-identical
-    states)."""
+    integrate_kernel in its own process, only the model's functions (that the two kernels give
+    the same states bit for bit: tests/test_continuation.py)."""
     args = ("cycle", "--model", str(ROOT / "examples" / "belt.json"))
     _compile_kernels(tmp_path, "variational")
     # a whole cache entry loads without the kernel lock (a helper compiling another kernel may
@@ -86,10 +85,7 @@ def test_the_variational_kernel_stands_in_for_the_lean_one_on_a_cold_cycle(tmp_p
     assert res["code"] == 0, res["out"]
     assert not [q for q in res["compiled"] if "integrate_kernel" in q], res["compiled"]
     assert res["compiled"], "the model's own functions compile in the command's process"
-    _compile_kernels(tmp_path, "lean")
-    warm = _cold_cli(tmp_path, "0", *args)
-    assert warm["code"] == 0 and warm["out"] == res["out"] and "stable cycle" in res["out"]
-    assert not [q for q in warm["compiled"] if "integrate_kernel" in q]
+    assert "stable cycle" in res["out"]
 
 
 def test_the_variational_kernel_stands_in_for_the_lean_one_only_when_it_is_ready_first(monkeypatch):

@@ -46,6 +46,27 @@ def test_the_variational_kernel_runs_dop853_as_the_full_one_does(monkeypatch):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
 
 
+@pytest.mark.parametrize("name,x0,T", [("table9.1", [0.1, -0.2, 0.03], 5.0),
+                                      ("table8.1-lugre", [-0.02, 0.05, 0.01, 1e-5], 2.0)])
+def test_the_variational_kernel_stands_in_for_the_lean_one_bit_for_bit(monkeypatch, name, x0, T):
+    """A plain DOP853 simulation on the variational kernel (where it stands in for an uncompiled
+    lean one, :func:`hunting.integrate._kernel.plain_kind`) gives the lean kernel's times,
+    states, modes and events bit for bit."""
+    from hunting.integrate import _kernel as K
+    from hunting.integrate.simulate import simulate
+    system = preset(name).system
+    runs = {}
+    for kind in ("lean", "variational"):
+        monkeypatch.setattr(K, "plain_kind", lambda kind=kind: kind)
+        runs[kind] = simulate(system, x0, (0.0, T))
+    a, b = runs["lean"], runs["variational"]
+    assert a.success and len(a.events.t) >= 2
+    for field in ("t", "x", "mode"):
+        np.testing.assert_array_equal(getattr(a, field), getattr(b, field), err_msg=field)
+    for field in ("t", "x_before", "x_after", "guard", "mode_from", "mode_to"):
+        np.testing.assert_array_equal(getattr(a.events, field), getattr(b.events, field), err_msg=field)
+
+
 @pytest.mark.parametrize("name,kw,par,x0,T,method", [
     ("table9.1", {}, "P", [0.1, -0.2, 0.03], 2.5, "dop853"),                 # stick exit moves with P
     ("table9.1", dict(beta="inf"), "Fs", [0.1, -0.2, 0.03], 2.5, "dop853"),  # the jump in f moves with Fs
