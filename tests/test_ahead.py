@@ -90,11 +90,15 @@ def test_the_variational_kernel_stands_in_for_the_lean_one_on_a_cold_cycle(tmp_p
 
 def test_the_variational_kernel_stands_in_for_the_lean_one_only_when_it_is_ready_first(monkeypatch):
     """plain_kind: the lean kernel where it is compiled or cached; else the variational one
-    where that is, or where the helper compiles it before the lean one; else the lean one."""
+    where that is, or where the helper compiles it before the lean one; else the lean one.
+    While the variational kernel stands in, the lean one's cache is looked up again only every
+    LEAN_LOOKUP seconds (a file read), then found."""
+    from types import SimpleNamespace
+
     from hunting.integrate import _kernel as K
-    lean, var = K._DISPATCHERS["lean"], K._DISPATCHERS["variational"]
-    if lean.overloads or var.overloads:
-        pytest.skip("a kernel is compiled in this process already")
+    lean, var = SimpleNamespace(overloads={}), SimpleNamespace(overloads={})   # kernels as plain_kind sees them
+    monkeypatch.setattr(K, "_DISPATCHERS", dict(K._DISPATCHERS, lean=lean, variational=var))
+    names = {id(lean): "lean", id(var): "variational"}
     for cached, queue, kind in [({"lean"}, ("variational", "lean"), "lean"),
                                 ({"lean", "variational"}, (), "lean"),
                                 ({"variational"}, (), "variational"),
@@ -103,10 +107,23 @@ def test_the_variational_kernel_stands_in_for_the_lean_one_only_when_it_is_ready
                                 (set(), ("lean", "variational"), "lean"),
                                 (set(), ("full",), "lean"),
                                 (set(), (), "lean")]:
-        names = {id(lean): "lean", id(var): "variational"}
         monkeypatch.setattr(ahead, "cached", lambda disp, sig: names.get(id(disp)) in cached)
         monkeypatch.setattr(ahead, "queued", lambda: queue)
         assert K.plain_kind() == kind, (cached, queue)
+    assert K.plain_kind() == "lean"
+    lean.overloads["sig"] = object()                       # compiled in this process: no lookup at all
+    monkeypatch.setattr(ahead, "cached", lambda disp, sig: pytest.fail("looked up a compiled kernel"))
+    assert K.plain_kind() == "lean"
+    lean.overloads.clear()
+    var.overloads["sig"] = object()                        # standing in, the lean kernel not cached
+    lookups = []
+    monkeypatch.setattr(ahead, "cached", lambda disp, sig: lookups.append(names[id(disp)]) or False)
+    monkeypatch.setattr(K, "_lean_looked_up", -float("inf"))
+    assert [K.plain_kind() for _ in range(50)] == ["variational"] * 50
+    assert lookups == ["lean"]
+    monkeypatch.setattr(ahead, "cached", lambda disp, sig: names[id(disp)] == "lean")   # the helper cached it
+    monkeypatch.setattr(K, "_lean_looked_up", K._lean_looked_up - K.LEAN_LOOKUP)
+    assert K.plain_kind() == "lean"
 
 
 def test_no_helper_when_switched_off_with_one_core_or_cached(monkeypatch):

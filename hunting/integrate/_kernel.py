@@ -12,6 +12,9 @@ velocity that was just set to zero by a transition -- are *unarmed*: they are sa
 dense output and armed once they have moved away from zero on the non-firing side. An unarmed
 guard that instead moves beyond ``guard_tol`` on the firing side fires at that threshold.
 """
+import math
+import time
+
 import numba
 import numpy as np
 from numba import types
@@ -903,8 +906,16 @@ def plain_kind() -> str:
     slower (table 9.1 and a 4-state PID + LuGre loop, both kernels in one process called in
     alternation); standing in, it saves that command the lean kernel's compile (~9 s CPU),
     which the helper does after the variational one, for the next command."""
+    global _lean_looked_up
     lean, var = _DISPATCHERS["lean"], _DISPATCHERS["variational"]
-    if lean.overloads or ahead.cached(lean, KERNEL_SIG):
+    if lean.overloads:
+        return "lean"
+    # standing in already: the lean kernel's cache index (a file read, ~0.4 ms) is looked up
+    # again at most every LEAN_LOOKUP seconds, not on every simulation or batch
+    if var.overloads and time.monotonic() - _lean_looked_up < LEAN_LOOKUP:
+        return "variational"
+    _lean_looked_up = time.monotonic()
+    if ahead.cached(lean, KERNEL_SIG):
         return "lean"
     if var.overloads or ahead.cached(var, KERNEL_SIG):
         return "variational"
@@ -912,6 +923,10 @@ def plain_kind() -> str:
     if "variational" in order and order.index("variational") < (order.index("lean") if "lean" in order else len(order)):
         return "variational"
     return "lean"
+
+
+LEAN_LOOKUP = 1.0           # [s] between looks for the lean kernel in the cache while the variational one stands in
+_lean_looked_up = -math.inf
 
 
 def calls_jacobian(method: int) -> bool:
