@@ -555,32 +555,40 @@ def test_stribeck_dip_fitted_on_a_one_way_record_is_taken_symmetric():
     assert d.causes[0].gain["extended"] < 0.2 * d.causes[0].gain["nominal"]
 
 
-def test_dwell_seen_as_a_break_away_excess_after_every_rest():
+def test_break_away_excess_after_every_rest_is_a_static_level_with_dwell_its_alternative():
     """reporting11 d0422: a dwell growth of 1.97 N complete in 0.14 s; the 4 rests (2 + 2, both
     directions) last 0.7-2.0 s and each breaks away about 1.9 N above Fs. Too few rests for the
-    growth test, and a growth its null (a level per direction) could not see anyway. The level
-    verdict names it (no p-value: its rule is said instead), gain within 5 %; a Stribeck change,
-    which would raise every break-away too, was tested on the sliding data and gained 3.7 %."""
+    growth test, and a growth its null (a level per direction) could not see anyway. Without a
+    growth the rests cannot tell a dwell effect from a higher static level: the level verdict (no
+    p-value: its rule is said instead) names the static level (stribeck, Fs up by the truth's gain
+    within 5 %) and lists the dwell reading, gain within 5 %, as the alternative of the same
+    evidence."""
     from hunting.diagnose.report import format_terminal
     fit, val, model, truth = _dataset("reporting11", 422)
     d = diagnose(fit, model, val, behaviour=False)
-    assert [c.name for c in d.causes] == ["dwell"], [(c.name, c.parameters) for c in d.causes]
+    assert [c.name for c in d.causes] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
     c = d.causes[0]
+    gain = truth["effects"][0]["params"]["gain"]
     assert c.p_value is None and "every one of the 4 rests" in c.gain["evidence"]
-    assert c.parameters["gain"] == pytest.approx(truth["effects"][0]["params"]["gain"], rel=0.05)
-    assert "evidence: every one of the 4 rests" in format_terminal(d)
+    assert c.parameters["Fs"] - model.curve.positive.Fs == pytest.approx(gain, rel=0.05)
+    assert c.parameters["Fs"] == pytest.approx(d.extended_model.curve.positive.Fs, rel=1e-12)
+    alt = next(a for a in d.alternatives if a["name"] == "dwell")
+    assert alt["kind"] == "same evidence" and alt["replaces"] == "stribeck"
+    assert alt["parameters"]["gain"] == pytest.approx(gain, rel=0.05)
+    text = format_terminal(d)
+    assert "evidence: every one of the 4 rests" in text and "dwell (the same evidence read in place of stribeck)" in text
 
 
-def test_dwell_break_away_excess_not_named_where_a_stribeck_change_is_untested():
+def test_break_away_excess_where_a_stribeck_change_is_untested_names_the_static_level():
     """reporting9 d0317: a Stribeck change (a higher Fs) on a record with too few sliding samples
-    for the force channel. Every break-away is higher, as a dwell effect would make it; with the
-    Stribeck change untested nothing is named and the dwell row says why."""
+    for the force channel. Every break-away is higher: the static level is named from the rests
+    (it was rejected, "stribeck would explain it as well", before break-away levels were read as
+    a static level), Fs within 10 % of the truth."""
     fit, val, model, truth = _dataset("reporting9", 317)
     assert [e["cause"] for e in truth["effects"]] == ["stribeck"]
     d = diagnose(fit, model, val, behaviour=False)
-    assert d.causes == []
-    row = next(r for r in d.rejected if r["name"] == "dwell")
-    assert "stribeck would explain it as well and the force channel could not test it" in row["reason"]
+    assert [c.name for c in d.causes] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
+    assert d.causes[0].parameters["Fs"] == pytest.approx(truth["effects"][0]["params"]["Fs"], rel=0.1)
 
 
 def test_dwell_break_away_excess_beside_a_coulomb_level():

@@ -96,10 +96,15 @@ def format_terminal(dg: Diagnosis, *, width: int = 100) -> str:
         out.append("")
         out.append("Alternatives (other readings of the same data):")
         for a in dg.alternatives:
+            g = a["gain"]
+            if a.get("kind") == "same evidence":
+                out.append(wrap(f"{a['name']} (the same evidence read in place of {a['replaces']}): "
+                                f"{parameter_text(a['name'], a['parameters'])}; {g['metric']}: "
+                                f"{_q(g['nominal'], None, 'N')} -> {_q(g['extended'], None, 'N')}"))
+                continue
             how = (f"in place of {a['replaces']}" if a.get("kind") == "same family"
                    else "alone; adds nothing once {} {} in".format(", ".join(a.get("absorbed_by", [])) or "the causes",
                                                                       "is" if len(a.get("absorbed_by", [])) == 1 else "are"))
-            g = a["gain"]
             out.append(wrap(f"{a['name']} ({how}): {parameter_text(a['name'], a['parameters'])}; validation force "
                             f"residual {_q(g['extended'], None, 'N')}, BIC {a['bic_difference']:+.1f}"))
     if dg.explanations:
@@ -281,9 +286,11 @@ def write_report(dg: Diagnosis, directory) -> Path:
     rej = "".join(f"<li>{html.escape(r['name'])}: {html.escape(_reason(r))}</li>" for r in dg.rejected)
     unt = "".join(f"<li>{html.escape(u['name'])}: {html.escape(u['reason'])}</li>" for u in dg.untested)
     alt = "".join(f"<li>{html.escape(a['name'])} ("
-                  + html.escape(f"in place of {a['replaces']}" if a.get("kind") == "same family"
+                  + html.escape(f"in place of {a['replaces']}" if a.get("kind") == "same family" else
+                                f"the same evidence read in place of {a['replaces']}" if a.get("kind") == "same evidence"
                                 else "alone, absorbed by " + ", ".join(a.get("absorbed_by", [])))
-                  + f"): {html.escape(parameter_text(a['name'], a['parameters']))}; BIC {a['bic_difference']:+.1f}</li>"
+                  + f"): {html.escape(parameter_text(a['name'], a['parameters']))}"
+                  + ("" if a.get("bic_difference") is None else f"; BIC {a['bic_difference']:+.1f}") + "</li>"
                   for a in dg.alternatives)
     finds = "".join(f"<li>{html.escape(c.name)}: {html.escape(finding(dg, c))}</li>" for c in dg.causes)
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>hunting diagnosis</title></head><body>

@@ -24,7 +24,10 @@ The rule (stated in every report, :data:`RULE`):
   only the recorded signals) are judged before every other channel: where one holds on the
   nominal model, the others are judged on its extension, so that their re-simulations run the
   loop the machine has; where it fails there, it is judged again in its place, on their
-  extension;
+  extension. A verdict may read its evidence twice (dwell's break-away excess after every rest:
+  a higher static level, named ``stribeck``, or a dwell growth complete by the shortest rest);
+  the cause with nothing unseen in it is named unless the force channel found a cause of its
+  rival's family, and the other is listed as an alternative (:func:`_own_channel`);
 - stick-channel causes (``CHANNEL = "stick"``: presliding) are judged on the samples where the
   (force-extended) model says the mass sticks: a chi-square test of the motion there against the
   sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
@@ -75,7 +78,10 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "{loop_gain:.0%}; a noise-fed cause that fails only along the reference trajectory, when fitted on the fitting "
         "record's loop it cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
         "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts both records' "
-        "position error by at least {loop_gain:.0%}")
+        "position error by at least {loop_gain:.0%}; a break-away excess every rest of both records shows (at least "
+        "{level_rests} rests, both directions, each at least {level_ratio:g} times its reading's error scale): a static level higher by it "
+        "(stribeck), or a dwell growth complete by the shortest rest where the force channel found a friction-curve "
+        "cause")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -118,9 +124,10 @@ class Diagnosis:
     criterion : the selection rule; kin_fit, kin_val : kinematics; r_* : residuals (n,) of the
     nominal and extended model on both sets (NaN where not used: |v| small or filter edges);
     rejected : candidates that failed the rule (with the reason); alternatives : other readings
-    of the data (a cause of the same family that would replace a selected one, or a cause that
-    explains the data alone but adds nothing once the selected ones are in), each with its
-    parameters, validation gain and BIC difference; explanations : the runner-up sets of the
+    of the data (a cause of the same family that would replace a selected one, a cause that
+    explains the data alone but adds nothing once the selected ones are in, or another reading of
+    a selected cause's own evidence, kind "same evidence"), each with its parameters, validation
+    gain and BIC difference (None for "same evidence"); explanations : the runner-up sets of the
     force channel's search with their BIC difference and validation RMS; untested : causes this
     record cannot test, with the reason; extended_model : the nominal model with every selected
     extension; behaviour : the behaviour view on the validation data (None without a controller
@@ -232,9 +239,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     from .force import REFERENCE_GAIN, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN
     from .causes.dwell_loop import GATE as DWELL_GATE
+    from .causes.dwell import LEVEL_RATIO, MIN_LEVEL_RESTS
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN,
-                      dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE)
+                      dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
+                      level_ratio=LEVEL_RATIO)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
@@ -314,9 +323,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             if name not in ticked:
                 tick(name)
             cause, row, ext = _own_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim, res,
-                                           lambda rivals: _unruled_rivals(rivals, result, rejected, untested, min_gain))
+                                           lambda rivals: _found_family(rivals, result))
             if cause is not None:
                 result.append(cause)
+                if row is not None:                    # the other reading of the same evidence
+                    fc["alternatives"] = list(fc["alternatives"]) + [row]
             elif row.get("untested"):
                 untested.append(dict(name=name, reason=row["reason"]))
             else:
@@ -851,22 +862,28 @@ def _idle_after_refinement(lib, ex, cov, hyper_sigma, min_gain: float):
     return ex, cov, hyper_sigma, idle
 
 
-def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolution, unruled=lambda rivals: None):
+def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolution, found=lambda names: False):
     """Judge a cause with its own evidence and gain (``CHANNEL = "own"``: dwell, saturation,
     quantization): its ``judge`` returns the statistic, p-value, fitted parameters and the
     validation metric nominal / extended, or a reason; accepted when p < alpha and the metric
     falls by at least min_gain. A verdict may carry ``otherwise``, the verdict on a second form of
     evidence (its own ``significant`` and ``evidence`` instead of a p-value), judged when the
-    first fails; its ``rivals`` are force-channel causes the evidence cannot tell it from, and it
-    stands only where ``unruled(rivals)`` (:func:`_unruled_rivals`) gives no reason. Returns
-    (Cause or None, rejected row or None, model)."""
+    first fails. That verdict may hold a second reading of the same evidence, ``instead`` (a verdict
+    with its cause's ``name`` and the cause it is the ``alternative`` to), named unless
+    ``found(rivals)`` says the force channel found a cause of the family of one of the verdict's
+    ``rivals`` (dwell's break-away level: a higher static level, unless the sliding data fixed the
+    curve's; :func:`_found_family`), the first reading then its alternative. Returns (Cause, the
+    alternative reading or None, extended model) or (None, rejected row, model)."""
     v = mod.judge(fit, val, kf, kv, model, can_sim, resolution)
     first = _own_failure(v, alpha, min_gain)
     if first is not None and "otherwise" in v:
         second = _own_failure(v["otherwise"], alpha, min_gain)
         if second is None:
-            rival = unruled(v["otherwise"].get("rivals", ()))
-            v, first = v["otherwise"], (None if rival is None else f"{v['otherwise']['evidence']}; but {rival}")
+            v, first = v["otherwise"], None
+            if "instead" in v and not found(v.get("rivals", ())):
+                v = dict(v["instead"], alternative=dict(
+                    name=mod.NAME, kind="same evidence", replaces=v["instead"]["name"], parameters=v["parameters"],
+                    bic_difference=None, gain=dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"])))
         else:
             first = f"{first}; and {second}"
     row = dict(name=mod.NAME, step="own", statistic=v.get("statistic"), p_value=v.get("p_value"))
@@ -874,33 +891,20 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
         return None, dict(row, validation_gain=None, reason=v["reason"], untested=bool(v.get("untestable"))), model
     if first is not None:
         return None, dict(row, validation_gain=_own_gain(v), reason=first), model
-    return (Cause(mod.NAME, v["nominal"] / max(v["extended"], 1e-300) - 1, v["statistic"], v["p_value"],
-                  v["parameters"], v["sigma"], dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"],
-                                                    **({"evidence": v["evidence"]} if "evidence" in v else {})),
-                  increments=v.get("increments", {}), family=getattr(mod, "FAMILY", mod.NAME)),
-            None, v["model"])
+    name = v.get("name", mod.NAME)
+    gain = dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"],
+                **({"evidence": v["evidence"]} if "evidence" in v else {}))
+    return (Cause(name, v["nominal"] / max(v["extended"], 1e-300) - 1, v.get("statistic"), v.get("p_value"),
+                  v["parameters"], v["sigma"], gain, increments=v.get("increments", {}),
+                  family=getattr(CAUSES[name], "FAMILY", name)),
+            v.get("alternative"), v["model"])
 
 
-def _unruled_rivals(rivals, found: list, rejected: list, untested: list, min_gain: float) -> str | None:
-    """Why the force channel leaves some of ``rivals`` (cause names) standing as explanations of
-    an own-evidence finding, or None when each, or a cause of its family, was found (the model the
-    finding is judged on holds what the sliding data say of it: reporting10 d0535 and d0584, a
-    dwell effect beside a Coulomb level, where a Stribeck change alone also lowered the residual)
-    or it was tested and lowered the validation residual alone by less than min_gain (the sliding
-    data do not ask for it: reporting11 d0422, a dwell effect on a one-way record where a Stribeck
-    change gained 3.7 %, p = 0.053)."""
-    rows = {r["name"]: r for r in rejected}
-    for name in rivals:
-        if any(c.family == getattr(CAUSES[name], "FAMILY", name) for c in found):
-            continue
-        g = rows.get(name, {}).get("validation_gain")
-        if g is None:
-            why = next((u["reason"] for u in untested if u["name"] == name),
-                       rows[name]["reason"] if name in rows else "it was not searched")
-            return f"{name} would explain it as well and the force channel could not test it ({why})"
-        if g >= min_gain:
-            return f"{name} would explain it as well: alone it lowers the validation force residual by {g:.0%}"
-    return None
+def _found_family(names, found: list) -> bool:
+    """Whether ``found`` (Cause list) holds a cause of the family of one of ``names`` (the model
+    the finding is judged on then holds what the sliding data say of it: reporting10 d0535 and
+    d0584, a dwell effect beside a Coulomb level)."""
+    return any(c.family == getattr(CAUSES[n], "FAMILY", n) for n in names for c in found)
 
 
 def _own_gain(v: dict) -> float:

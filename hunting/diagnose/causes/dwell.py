@@ -335,7 +335,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         out = _regained(out, tv, Fv, sv, np.concatenate([t, tv]), np.concatenate([F, Fv]), np.concatenate([s, sv]))
         loop = dwell_loop.verdict(loop, validate, model, out["p_value"])
     level = level_verdict(np.concatenate([t, tv]), np.concatenate([F, Fv]), np.concatenate([s, sv]),
-                          np.concatenate([scale, scale_v]), model)
+                          np.concatenate([scale, scale_v]), model, sliding_speeds(kf, kv))
     if level is not None:
         return dict(out, otherwise=level)
     return out if loop is None else dict(out, otherwise=loop)
@@ -357,9 +357,10 @@ def _regained(out: dict, tv, Fv, sv, t_all, F_all, s_all) -> dict:
     return dict(out, metric=metric, extended=float(np.sqrt(np.mean(e1 ** 2))))
 
 
-def level_verdict(t, F, s, scale, model) -> dict | None:
+def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
     """The verdict on a break-away excess that every rest shows (t, F, s, scale (m,): the rests of
-    both records, :func:`rests`), or None where it does not hold.
+    both records, :func:`rests`; speeds: the sliding speeds the force channel judged [m/s],
+    :func:`sliding_speeds`), or None where it does not hold.
 
     When the rests all outlast the growth (its time below the shortest rest), the excess is the
     same after every rest and the growth test, whose null holds a level per direction (a wrong Fs
@@ -368,13 +369,16 @@ def level_verdict(t, F, s, scale, model) -> dict | None:
     directions (one direction is an asymmetry), each with an excess of at least LEVEL_RATIO times
     its reading's error scale plus LEVEL_FLOOR of Fs. Not a p-value: the rule is calibrated on
     clean records (the largest smallest ratio over the 337 clean tuning and tuning-clean records
-    where it applies was 0.70; over 849 clean reporting9-11 records 0.82). The growth is then
-    taken complete by the shortest rest (time = t_min / 5, an upper bound: 99 % grown there) and
-    its gain fitted; the gain out of sample: each rest's excess predicted by the gain fitted on
-    the others (leave-one-out), against the model's break-away force. A higher static force of the
-    sliding curve (``rivals``: stribeck) raises every break-away as well: the finding stands only
-    where the force channel found it or its sliding data speak against it (reporting9 d0317, a
-    Stribeck change on a record with too few sliding samples to test it, was named dwell)."""
+    where it applies was 0.70; over 849 clean reporting9-11 records 0.82).
+
+    Two readings of the same excess (the verdict holds the dwell one and, as ``instead``, the
+    static-level one; :func:`hunting.diagnose.select._own_channel` names the second unless the
+    force channel found a cause of the friction-curve family, ``rivals``, whose static level the
+    sliding data already fixed): a static level Fs higher by the excess (:func:`static_reading`),
+    the reading with nothing unseen in it, or a dwell growth complete by the shortest rest (time =
+    t_min / 5, an upper bound: 99 % grown there) with its gain fitted. Either gain out of sample:
+    each rest's excess predicted by the others (leave-one-out), against the model's break-away
+    force."""
     from ..model import Dwell
     if t.size < MIN_LEVEL_RESTS or np.unique(s).size < 2:
         return None
@@ -385,22 +389,63 @@ def level_verdict(t, F, s, scale, model) -> dict | None:
         return None
     tau = float(t.min()) / 5
     w = 1 - np.exp(-t / tau)
-    ww = float(w @ w)
-    g = float(w @ e) / ww
-    loo = np.array([e[k] - w[k] * (float(w @ e) - w[k] * e[k]) / (ww - w[k] ** 2) for k in range(t.size)])
+    g, sig, loo = _constant_fit(e, w)
     base = model.dwell or Dwell(0.0, 0.0, tau)
     ext = model.replace(dwell=Dwell(base.level, base.gain + g, tau))
-    sig = float(np.sqrt(np.sum((e - g * w) ** 2) / (t.size - 1) / ww))
     d = ext.dwell
+    evidence = (f"every one of the {t.size} rests breaks away at least {ratio:.3g} times its reading's error scale "
+                f"above the model's static force (rule: >= {LEVEL_RATIO:g}); no growth with the rest resolved "
+                f"(rests of {t.min():.3g}-{t.max():.3g} s)")
     return dict(statistic=ratio, p_value=None, significant=True, rivals=("stribeck",),
-                evidence=(f"every one of the {t.size} rests breaks away at least {ratio:.3g} times its reading's "
-                          f"error scale above the model's static force (rule: >= {LEVEL_RATIO:g}); no growth "
-                          f"resolved: rests of {t.min():.3g}-{t.max():.3g} s, the time is an upper bound"),
+                evidence=f"{evidence}: the growth is complete by the shortest rest, its time an upper bound",
                 parameters={"level": d.level, "gain": d.gain, "time": d.time},
                 sigma={"level": None, "gain": sig, "time": None},
                 metric=(f"break-away force RMS error [N], each of the {t.size} rests of both records predicted by the "
                         "others (a break-away excess the same after every rest)"),
-                nominal=float(np.sqrt(np.mean(e ** 2))), extended=float(np.sqrt(np.mean(loo ** 2))), model=ext)
+                nominal=float(np.sqrt(np.mean(e ** 2))), extended=float(np.sqrt(np.mean(loo ** 2))), model=ext,
+                instead=static_reading(e, model, speeds, evidence))
+
+
+def _constant_fit(e: np.ndarray, w: np.ndarray) -> tuple[float, float, np.ndarray]:
+    """(g, its standard uncertainty, leave-one-out residuals (m,)) of the fit e = g w."""
+    ww = float(w @ w)
+    g = float(w @ e) / ww
+    loo = np.array([e[k] - w[k] * (float(w @ e) - w[k] * e[k]) / (ww - w[k] ** 2) for k in range(e.size)])
+    sig = float(np.sqrt(np.sum((e - g * w) ** 2) / (e.size - 1) / ww))
+    return g, sig, loo
+
+
+def static_reading(e: np.ndarray, model, speeds, evidence: str) -> dict:
+    """The break-away excess e (m,) [N] read as a static level Fs higher by its mean in both
+    directions: the ``stribeck`` cause's static-level variant at the model's own dip, or, on a
+    curve without a dip, at a Stribeck velocity below every sliding speed the force channel judged
+    (half their 2nd percentile, ``speeds``: the sliding data saw no dip, so it lies below them; an
+    upper bound). A verdict dict like :func:`level_verdict`'s, its cause named."""
+    from . import stribeck
+    pos, neg = model.curve.positive, model.curve.negative
+    if pos.Fs > pos.Fc and neg.Fs > neg.Fc:
+        hyper = {"vs": float(pos.vs), "vs_neg": float(neg.vs), "dip": True}
+        where = "at the model's Stribeck velocity"
+    else:
+        vs = 0.5 * float(np.percentile(speeds, 2)) if speeds is not None and speeds.size >= 10 else float(pos.vs)
+        hyper = {"vs": vs, "vs_neg": vs, "dip": True}
+        where = "the Stribeck velocity an upper bound: below the sliding speeds, which show no dip"
+    g, sig, loo = _constant_fit(e, np.ones_like(e))
+    theta = np.array([g])
+    return dict(name=stribeck.NAME, evidence=f"{evidence}: the static level is higher ({where})",
+                parameters=stribeck.parameters(theta, hyper, model),
+                sigma={"Fc": None, "Fs": sig, "vs": None, "vs_neg": None}, increments={"Fs": g},
+                metric=(f"break-away force RMS error [N], each of the {e.size} rests of both records predicted by the "
+                        "others (a static level raised by the same amount after every rest)"),
+                nominal=float(np.sqrt(np.mean(e ** 2))), extended=float(np.sqrt(np.mean(loo ** 2))),
+                model=stribeck.extend(model, theta, hyper), alternative="dwell")
+
+
+def sliding_speeds(*kins) -> np.ndarray:
+    """|v| [m/s] on the samples the force channel judges (``moving``) of the given kinematics
+    (None skipped)."""
+    parts = [np.abs(k.v[k.moving & np.isfinite(k.v)]) for k in kins if k is not None]
+    return np.concatenate(parts) if parts else np.zeros(0)
 
 
 def _growth_verdict(t, F, s, scale, tv, Fv, sv, scale_v, model) -> dict:
