@@ -577,6 +577,9 @@ def test_break_away_excess_after_every_rest_is_a_static_level_with_dwell_its_alt
     assert alt["parameters"]["gain"] == pytest.approx(gain, rel=0.05)
     text = format_terminal(d)
     assert "evidence: every one of the 4 rests" in text and "dwell (the same evidence read in place of stribeck)" in text
+    # the force channel's verdict on stribeck (sliding samples) is a note, not a rejection of the named cause
+    assert all(r["name"] != "stribeck" for r in d.rejected)
+    assert any(n.startswith("stribeck is named from the dwell cause's own evidence") for n in d.notes)
 
 
 def test_break_away_excess_where_a_stribeck_change_is_untested_names_the_static_level():

@@ -328,6 +328,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
                 result.append(cause)
                 if row is not None:                    # the other reading of the same evidence
                     fc["alternatives"] = list(fc["alternatives"]) + [row]
+                # a force-channel cause named from other evidence: its sliding-data verdict is a note
+                for r in [r for r in rejected if r["name"] == cause.name]:
+                    rejected.remove(r)
+                    notes.append(OTHER_EVIDENCE_NOTE.format(name=cause.name, channel=name, reason=r.get("reason", "")))
             elif row.get("untested"):
                 untested.append(dict(name=name, reason=row["reason"]))
             else:
@@ -605,6 +609,8 @@ INTERLEAVE_WINDOWS = 8   # filter windows per block of :func:`_interleaved`
 VALIDATION_ONLY_NOTE = ("the fitting data cannot show {names} ({reasons}): searched on alternate blocks of "
                         + str(INTERLEAVE_WINDOWS) + " filter windows of the validation data ({val}), on top of the "
                         "causes found, and judged on the others")
+OTHER_EVIDENCE_NOTE = ("{name} is named from the {channel} cause's own evidence (its evidence line); on the sliding "
+                       "samples (the force channel) it was not selected: {reason}")
 POOR_FIT_NOTE = ("the fitting data ({name}) have {n} sliding samples the force channel can use (away from stops, "
                  "the friction map not too steep there), spanning {windows:.1f} filter windows (it needs 100 spanning "
                  + str(MIN_WINDOWS) + "): the force channel fitted on the first 60 % of the validation data ({val}) and "
