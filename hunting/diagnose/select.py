@@ -79,9 +79,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "record's loop it cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
         "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts both records' "
         "position error by at least {loop_gain:.0%}; a break-away excess every rest of both records shows (at least "
-        "{level_rests} rests, both directions, each at least {level_ratio:g} times its reading's error scale): a static level higher by it "
-        "(stribeck), or a dwell growth complete by the shortest rest where the force channel found a friction-curve "
-        "cause")
+        "{level_rests} rests, both directions, each at least {level_ratio:g} times its reading's error scale): a "
+        "static level higher by it (stribeck), or a dwell growth complete by the shortest rest where the force channel "
+        "found a friction-curve cause")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -875,7 +875,7 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     falls by at least min_gain. A verdict may carry ``otherwise``, the verdict on a second form of
     evidence (its own ``significant`` and ``evidence`` instead of a p-value), judged when the
     first fails. That verdict may hold a second reading of the same evidence, ``instead`` (a verdict
-    with its cause's ``name`` and the cause it is the ``alternative`` to), named unless
+    with its cause's ``name``), named unless
     ``found(rivals)`` says the force channel found a cause of the family of one of the verdict's
     ``rivals`` (dwell's break-away level: a higher static level, unless the sliding data fixed the
     curve's; :func:`_found_family`), the first reading then its alternative. Returns (Cause, the

@@ -438,7 +438,7 @@ def static_reading(e: np.ndarray, model, speeds, evidence: str) -> dict:
                 metric=(f"break-away force RMS error [N], each of the {e.size} rests of both records predicted by the "
                         "others (a static level raised by the same amount after every rest)"),
                 nominal=float(np.sqrt(np.mean(e ** 2))), extended=float(np.sqrt(np.mean(loo ** 2))),
-                model=stribeck.extend(model, theta, hyper), alternative="dwell")
+                model=stribeck.extend(model, theta, hyper))
 
 
 def sliding_speeds(*kins) -> np.ndarray:
