@@ -79,9 +79,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "record's loop it cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
         "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts both records' "
         "position error by at least {loop_gain:.0%}; a break-away excess every rest of both records shows (at least "
-        "{level_rests} rests, both directions, each at least {level_ratio:g} times its reading's error scale): a "
-        "static level higher by it (stribeck), or a dwell growth complete by the shortest rest where the force channel "
-        "found a friction-curve cause")
+        "{level_rests} rests, both directions, all above the model's static force and {level_share:.0%} of them by at "
+        "least {level_ratio:g} times their reading's error scale): a static level higher by it (stribeck), or a dwell "
+        "growth complete by the shortest rest where the force channel found a friction-curve cause")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -239,11 +239,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     from .force import REFERENCE_GAIN, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN
     from .causes.dwell_loop import GATE as DWELL_GATE
-    from .causes.dwell import LEVEL_RATIO, MIN_LEVEL_RESTS
+    from .causes.dwell import LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN,
                       dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
-                      level_ratio=LEVEL_RATIO)
+                      level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]

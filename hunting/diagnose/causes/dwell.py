@@ -50,7 +50,8 @@ DRAWS = 20000          # permutations of the growth test (p >= 5e-5)
 GROWTH_TIMES = 12      # time constants the growth test's score tries
 DEPARTURE_PASSES = 4   # fixed-point passes of the break-away reading (departure time and excess force)
 MIN_LEVEL_RESTS = 3    # rests of both records for a break-away level (:func:`level_verdict`)
-LEVEL_RATIO = 3.0      # each rest's excess over its reading's error scale, for a break-away level
+LEVEL_RATIO = 3.0      # a rest's excess over its reading's error scale, for a break-away level ...
+LEVEL_SHARE = 0.8      # ... in at least this share of the rests (every one above the model's static force)
 LEVEL_FLOOR = 0.02     # of Fs: the smallest error scale of a break-away reading
 
 
@@ -366,10 +367,16 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
     same after every rest and the growth test, whose null holds a level per direction (a wrong Fs
     or an asymmetry), cannot see it (reporting11 d0422: 4 rests of 0.7-2.0 s, each 1.9 N above Fs,
     the truth's growth complete in 0.14 s). Evidence: at least MIN_LEVEL_RESTS rests, in both
-    directions (one direction is an asymmetry), each with an excess of at least LEVEL_RATIO times
-    its reading's error scale plus LEVEL_FLOOR of Fs. Not a p-value: the rule is calibrated on
-    clean records (the largest smallest ratio over the 337 clean tuning and tuning-clean records
-    where it applies was 0.70; over 849 clean reporting9-11 records 0.82).
+    directions (one direction is an asymmetry), every one breaking away above the model's static
+    force and at least LEVEL_SHARE of them by LEVEL_RATIO times its reading's error scale plus
+    LEVEL_FLOOR of Fs (the ratio that share reaches is the statistic). Not a p-value: the rule is
+    calibrated on clean records. Its first form asked every rest for the ratio (the largest
+    smallest ratio over the 337 clean tuning and tuning-clean records where it applies was 0.70;
+    over 849 clean reporting9-11 records 0.82; over 1879 clean reporting13-19 records 1.35), and
+    a few noisy readings among many vetoed it (reporting19 d0485: 55 rests 11-18 N above Fs, the
+    lowest ratio 0.97). On those 1879 clean records 40 had every rest above Fs, and the ratio 80 %
+    of their rests reached was at most 1.72; on the true records of reporting13-19 the share rule
+    fires on 16 more (all with a Stribeck, level or dwell change), on none fewer.
 
     Two readings of the same excess (the verdict holds the dwell one and, as ``instead``, the
     static-level one; :func:`hunting.diagnose.select._own_channel` names the second unless the
@@ -384,8 +391,10 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
         return None
     Fs = np.where(s > 0, model.curve.positive.Fs, model.curve.negative.Fs)
     e = excess(model, t, F, s)
-    ratio = float(np.min(e / (scale + LEVEL_FLOOR * Fs)))
-    if not ratio >= LEVEL_RATIO:
+    # the ratio at least LEVEL_SHARE of the rests reach (the lowest of that share)
+    ratios = np.sort(e / (scale + LEVEL_FLOOR * Fs))
+    ratio = float(ratios[t.size - int(np.ceil(LEVEL_SHARE * t.size))])
+    if not (np.min(e) > 0 and ratio >= LEVEL_RATIO):
         return None
     tau = float(t.min()) / 5
     w = 1 - np.exp(-t / tau)
@@ -393,9 +402,9 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
     base = model.dwell or Dwell(0.0, 0.0, tau)
     ext = model.replace(dwell=Dwell(base.level, base.gain + g, tau))
     d = ext.dwell
-    evidence = (f"every one of the {t.size} rests breaks away at least {ratio:.3g} times its reading's error scale "
-                f"above the model's static force (rule: >= {LEVEL_RATIO:g}); no growth with the rest resolved "
-                f"(rests of {t.min():.3g}-{t.max():.3g} s)")
+    evidence = (f"every one of the {t.size} rests breaks away above the model's static force, {LEVEL_SHARE:.0%} of "
+                f"them by at least {ratio:.3g} times their reading's error scale (rule: >= {LEVEL_RATIO:g}); no "
+                f"growth with the rest resolved (rests of {t.min():.3g}-{t.max():.3g} s)")
     return dict(statistic=ratio, p_value=None, significant=True, rivals=("stribeck",),
                 evidence=f"{evidence}: the growth is complete by the shortest rest, its time an upper bound",
                 parameters={"level": d.level, "gain": d.gain, "time": d.time},
