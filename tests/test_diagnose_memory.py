@@ -225,16 +225,17 @@ def test_dwell_level_verdict_fits_the_break_away_excess_every_rest_shows():
     assert v["nominal"] == pytest.approx(1.9, rel=0.02) and v["extended"] < 0.05
 
 
-@pytest.mark.parametrize("dip", [True, False])
+@pytest.mark.parametrize("dip", ["both", "none", "positive"])
 def test_dwell_level_verdict_reads_the_excess_as_a_static_level_too(dip):
     """The same excess read as a static level (``instead``): the stribeck cause, Fs raised by the
     mean excess in both directions (its leave-one-out prediction the mean of the other rests, by
-    brute force), Fc unchanged; at the model's own dip, or on a curve without one at half the
-    2nd percentile of the sliding speeds given."""
+    brute force), Fc unchanged; each direction at its own dip's velocity, a direction without
+    one at half the 2nd percentile of the sliding speeds given."""
     t, F, s, scale, model = _level_rests()
-    if dip:                                    # the same static level 10 N, above Fc = 8 N
+    if dip != "none":                          # the same static level 10 N, above Fc = 8 N
+        neg = {"Fc_neg": 10.0, "Fs_neg": 10.0} if dip == "positive" else {}
         model = NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0}, "friction": {
-            "law": "stribeck", "Fc": 8.0, "Fs": 10.0, "vs": 0.02, "beta": 2.0, "b": 0.0}})
+            "law": "stribeck", "Fc": 8.0, "Fs": 10.0, "vs": 0.02, "beta": 2.0, "b": 0.0, **neg}})
     speeds = np.linspace(0.01, 0.2, 1000)
     v = dwell.level_verdict(t, F, s, scale, model, speeds)["instead"]
     e = dwell.excess(model, t, F, s)
@@ -242,8 +243,8 @@ def test_dwell_level_verdict_reads_the_excess_as_a_static_level_too(dip):
     ext = v["model"]
     for c, c0 in ((ext.curve.positive, model.curve.positive), (ext.curve.negative, model.curve.negative)):
         assert c.Fs == pytest.approx(c0.Fs + e.mean(), rel=1e-12) and c.Fc == c0.Fc
-        assert c.vs == pytest.approx(c0.vs if dip else 0.5 * np.percentile(speeds, 2), rel=1e-12)
-    assert ext.law == ("stribeck" if not dip else model.law)
+        assert c.vs == pytest.approx(c0.vs if c0.Fs > c0.Fc else 0.5 * np.percentile(speeds, 2), rel=1e-12)
+    assert ext.law == ("stribeck" if dip == "none" else model.law)
     assert v["parameters"]["Fs"] == pytest.approx(ext.curve.positive.Fs, rel=1e-12)
     loo = [e[k] - np.delete(e, k).mean() for k in range(t.size)]
     assert v["extended"] == pytest.approx(np.sqrt(np.mean(np.square(loo))), rel=1e-9)

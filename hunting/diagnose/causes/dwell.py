@@ -426,19 +426,19 @@ def _constant_fit(e: np.ndarray, w: np.ndarray) -> tuple[float, float, np.ndarra
 
 def static_reading(e: np.ndarray, model, speeds, evidence: str) -> dict:
     """The break-away excess e (m,) [N] read as a static level Fs higher by its mean in both
-    directions: the ``stribeck`` cause's static-level variant at the model's own dip, or, on a
-    curve without a dip, at a Stribeck velocity below every sliding speed the force channel judged
-    (half their 2nd percentile, ``speeds``: the sliding data saw no dip, so it lies below them; an
-    upper bound). A verdict dict like :func:`level_verdict`'s, its cause named."""
+    directions: the ``stribeck`` cause's static-level variant, each direction at its own dip's
+    Stribeck velocity, or, for a direction without a dip, at one below every sliding speed the
+    force channel judged (half their 2nd percentile, ``speeds``: the sliding data saw no dip, so
+    it lies below them; an upper bound). A verdict dict like :func:`level_verdict`'s, its cause named."""
     from . import stribeck
-    pos, neg = model.curve.positive, model.curve.negative
-    if pos.Fs > pos.Fc and neg.Fs > neg.Fc:
-        hyper = {"vs": float(pos.vs), "vs_neg": float(neg.vs), "dip": True}
-        where = "at the model's Stribeck velocity"
-    else:
-        vs = 0.5 * float(np.percentile(speeds, 2)) if speeds is not None and speeds.size >= 10 else float(pos.vs)
-        hyper = {"vs": vs, "vs_neg": vs, "dip": True}
-        where = "the Stribeck velocity an upper bound: below the sliding speeds, which show no dip"
+    unseen = 0.5 * float(np.percentile(speeds, 2)) if speeds is not None and speeds.size >= 10 else None
+    # each direction at its own dip's velocity; one without a dip below the sliding speeds
+    vs = [float(c.vs) if c.Fs > c.Fc or unseen is None else unseen
+          for c in (model.curve.positive, model.curve.negative)]
+    hyper = {"vs": vs[0], "vs_neg": vs[1], "dip": True}
+    where = ("at the model's Stribeck velocity" if all(c.Fs > c.Fc for c in (model.curve.positive, model.curve.negative))
+             else "the Stribeck velocity of a direction without a dip an upper bound: below the sliding speeds, "
+                  "which show no dip")
     g, sig, loo = _constant_fit(e, np.ones_like(e))
     theta = np.array([g])
     return dict(name=stribeck.NAME, evidence=f"{evidence}: the static level is higher ({where})",
