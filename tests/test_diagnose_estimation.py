@@ -746,3 +746,50 @@ def test_a_clean_cause_the_reference_check_rejects_stays_rejected_on_the_loop():
     assert d.causes == []
     rows = [r for r in d.rejected if r.get("reference_only")]
     assert rows and all("; and on the loop: " in r["reason"] for r in rows)
+
+
+def test_a_friction_force_change_below_the_relevance_floor_is_not_a_cause():
+    """reporting20 d0187 (clean, 500 Hz, Fc = 0.486 N): the validation residual is 0.6 mN, 0.12 %
+    of Fc, and with so little noise a Stribeck change of 0.35 mN RMS (Fc 0.4 % higher) passed every
+    test (p = 1.3e-5, validation gain 30 %); without it a viscous change, without that a lag did.
+    Each moves the force by less than RELEVANCE of the Coulomb level: not a cause. Nothing is
+    named, and the rejections say why."""
+    from hunting.diagnose.force import RELEVANCE
+    fit, val, model, truth = _dataset("reporting20", 187)
+    assert truth["causes"] == []
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == [], [(c.name, c.parameters) for c in d.causes]
+    reasons = {r["name"]: r for r in d.rejected}
+    floor = RELEVANCE * 0.5 * (model.curve.positive.Fc + model.curve.negative.Fc)
+    assert f"({floor:.2g} N)" in reasons["stribeck"]["reason"]
+    # significant and large against the residual: only the floor rejected it
+    row = reasons["stribeck"]
+    assert row["p_value"] < 1e-3 and row["validation_gain"] > 0.05
+    assert row["reason"].startswith("its force change") and " and " not in row["reason"]
+
+
+def test_a_true_friction_change_just_above_the_relevance_floor_is_still_named():
+    """reporting18 d0429: a Stribeck change (the dip's velocity moved) whose force change on the
+    validation record's sliding samples is 0.39 % of Fc, the smallest among the true
+    friction-curve findings of the development sets: it stays named."""
+    fit, val, model, truth = _dataset("reporting18", 429)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert "stribeck" in [c.name for c in d.causes], [(c.name, c.parameters) for c in d.causes]
+    assert [e["cause"] for e in truth["effects"]] == ["stribeck"]
+
+
+def test_relevance_floor_is_sized_on_the_coulomb_level_for_friction_force_causes_only():
+    from hunting.diagnose.causes import CAUSES
+    from hunting.diagnose.force import RELEVANCE, _fails, _why, relevance_floor
+    model = NominalModel.from_dict({"plant": {"mass": 2.0}, "friction": {"law": "stribeck", "Fc": 4.0, "Fs": 5.0,
+                                                                          "vs": 0.01, "b": 1.0, "Fc_neg": 2.0,
+                                                                          "Fs_neg": 3.0, "vs_neg": 0.01, "b_neg": 1.0}})
+    friction = {n for n, m in CAUSES.items() if getattr(m, "FRICTION_FORCE", False)}
+    assert friction == {"offset", "asymmetry", "level", "stribeck", "viscous", "lag"}
+    for name in CAUSES:
+        expected = RELEVANCE * 3.0 if name in friction else 0.0
+        assert relevance_floor(model, name) == pytest.approx(expected)
+    t = dict(p_value=1e-9, gain=0.3, rms=1.0, rms_without=1.3, floor=1e-4, relevance=0.009)
+    assert _fails(dict(t, change=0.0089), 1e-3, 0.05, 0.01) and not _fails(dict(t, change=0.0091), 1e-3, 0.05, 0.01)
+    assert "below 0.3% of the Coulomb level (0.009 N)" in _why(dict(t, change=0.0089), 1e-3, 0.05)
+    assert not _fails(t, 1e-3, 0.05, 0.01)           # rows without a size (older callers) are not judged by it

@@ -12,7 +12,9 @@ The rule (stated in every report, :data:`RULE`):
   in the model, that prediction's shape, alone and summed with the other noise-fed causes',
   explains at least REFERENCE_GAIN x min_gain of it: feedback puts the sensor's and the
   actuator's noise into the measured regressors, not into the reference's),
-  dropping it grows the validation RMS by at least ``min_gain``, and the whole set beats each of
+  dropping it grows the validation RMS by at least ``min_gain``, a change of the friction force
+  itself (``FRICTION_FORCE``: offset, asymmetry, level, stribeck, viscous, lag) moves the
+  predicted force by at least ``RELEVANCE`` of the Coulomb level, and the whole set beats each of
   its subsets by as much; what fails is removed and the rest refitted, and when nothing of the
   set holds, the BIC-best set without the causes that failed is judged next; a special case
   (level) gives way to the general cause of its family (stribeck) when that explains the
@@ -67,7 +69,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "prewhitened, autocorrelation-consistent standard error, Student's t with the validation data's filter windows less one as degrees of freedom, p < {alpha:g}; with a moving reference its prediction "
         "along the reference too, p < {alpha_reference:g}, and, with a controller in the model, that prediction's shape, alone and with "
         "the other noise-fed causes', explains at least {reference_gain:.1%} of it), dropping it grows the validation RMS by at least "
-        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much and by {swap_share:.0%} of the nominal model's validation residual, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by both, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
+        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), a change of the friction force itself (offset, asymmetry, level, stribeck, viscous, lag) moves the force by at least {relevance:.1%} of the Coulomb level (RMS on the sliding samples: smaller is no cause), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much and by {swap_share:.0%} of the nominal model's validation residual, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by both, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%} (saturation, whose evidence reads only the measured "
         "output, and quantization, whose evidence reads only the recorded signals, first: where one holds on the nominal "
         "model every other channel is judged on its extension, and where it fails there it is judged again last, on "
@@ -236,14 +238,14 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     kv = kinematics(validate, model.cm, window=window, **sensor)
     check_units(kf, model, fit.name)
     check_units(kv, model, validate.name)
-    from .force import REFERENCE_GAIN, SWAP_SHARE
+    from .force import REFERENCE_GAIN, RELEVANCE, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN
     from .causes.dwell_loop import GATE as DWELL_GATE
     from .causes.dwell import LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN,
                       dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
-                      level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE)
+                      level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]

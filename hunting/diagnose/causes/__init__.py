@@ -18,7 +18,9 @@ increments, model)`` (the finding in words), ``untestable(kin, model)`` (why a r
 it), ``EXCLUDES`` (causes it cannot be combined with), ``NOISE_FED`` (its regressor is made of
 measured derivatives: judged also along a noise-free instrument trajectory), ``JUDGED_FIRST``
 (an own-evidence cause whose evidence reads only the measured records, judged before the other
-channels so that their re-simulations run on its extension). Adding a cause is
+channels so that their re-simulations run on its extension), ``FRICTION_FORCE`` (a change of the
+friction force itself, a constant or a map of the velocity: its size is judged against the
+Coulomb level, :func:`hunting.diagnose.force.relevance_floor`). Adding a cause is
 adding a module and listing it here."""
 from ..model import NominalModel
 from ...models.friction import DirectionalCurve

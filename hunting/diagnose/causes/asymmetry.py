@@ -11,6 +11,7 @@ from ._words import _pct, _q
 NAME = "asymmetry"
 DESCRIPTION = "direction-dependent viscous friction (b+ != b-)"
 FAMILY = "velocity"
+FRICTION_FORCE = True   # a change of the friction force (a constant or a map of the velocity): sized against Fc
 HYPERS = 0
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 EXCLUDES = ("viscous",)      # v = max(v, 0) + min(v, 0): viscous is the special case b+ = b-

@@ -27,6 +27,7 @@ from ._words import _pct, _q
 NAME = "level"
 DESCRIPTION = "friction level (Coulomb and static) scaled in both directions"
 FAMILY = "friction curve"
+FRICTION_FORCE = True   # a change of the friction force (a constant or a map of the velocity): sized against Fc
 HYPERS = 0
 EXCLUDES = ("stribeck",)      # both change the levels Fc and Fs; the shape change includes this one
 UNITS = {"Fc": "N", "Fs": "N", "scale": "", "Fc_neg": "N", "Fs_neg": "N"}

@@ -5,6 +5,7 @@ from ._words import _q
 NAME = "offset"
 DESCRIPTION = "constant force on the load"
 FAMILY = "constant force"
+FRICTION_FORCE = True   # a change of the friction force (a constant or a map of the velocity): sized against Fc
 HYPERS = 0
 UNITS = {"offset": "N"}
 

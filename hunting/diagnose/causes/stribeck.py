@@ -31,6 +31,7 @@ from ._words import _q
 NAME = "stribeck"
 DESCRIPTION = "velocity-weakening (Stribeck) shape: levels and vs"
 FAMILY = "friction curve"
+FRICTION_FORCE = True   # a change of the friction force (a constant or a map of the velocity): sized against Fc
 HYPERS = 2
 HYPER_KEYS = ("vs", "vs_neg")
 UNITS = {"Fc": "N", "Fs": "N", "vs": "m/s", "vs_neg": "m/s"}

@@ -7,6 +7,7 @@ from ._words import _q
 NAME = "viscous"
 DESCRIPTION = "viscous coefficient b"
 FAMILY = "velocity"
+FRICTION_FORCE = True   # a change of the friction force (a constant or a map of the velocity): sized against Fc
 HYPERS = 0
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 INSTRUMENTED = True   # its coefficient is estimated with the noise-free loop's regressor as instrument
