@@ -37,7 +37,8 @@ The rule (stated in every report, :data:`RULE`):
   Where that test has nothing (no creep beyond the counts, or too few stick samples) and the
   loop can be re-simulated, presliding's loop evidence judges bristles too stiff to creep at rest
   by what they do where the loop turns and stops: fitted on the fitting record's re-simulated
-  position, they must cut both records' position error by at least ``LOOP_GAIN``
+  position, they must cut its position error by at least ``LOOP_GAIN`` and the validation
+  record's by ``LOOP_VALIDATION_GAIN``
   (:func:`~hunting.diagnose.causes.presliding.loop_evidence`).
   Presliding and reversal are one family (LuGre bristles): when the force channel found
   reversal, presliding is not tested again.
@@ -74,13 +75,13 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "output, and quantization, whose evidence reads only the recorded signals, first: where one holds on the nominal "
         "model every other channel is judged on its extension, and where it fails there it is judged again last, on "
         "theirs); presliding, where no creep shows at rest, also "
-        "when LuGre bristles fitted on the fitting record's re-simulated loop cut both records' position error by at "
-        "least {loop_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
+        "when LuGre bristles fitted on the fitting record's re-simulated loop cut its position error by at least "
+        "{loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
         "that fitted on the fitting record's loop cuts its position error most, when it cuts both records' by at least "
         "{loop_gain:.0%}; a noise-fed cause that fails only along the reference trajectory, when fitted on the fitting "
         "record's loop it cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
-        "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts both records' "
-        "position error by at least {loop_gain:.0%}; a break-away excess every rest of both records shows (at least "
+        "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts its position "
+        "error by at least {loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; a break-away excess every rest of both records shows (at least "
         "{level_rests} rests, both directions, all above the model's static force and {level_share:.0%} of them by at "
         "least {level_ratio:g} times their reading's error scale): a static level higher by it (stribeck), or a dwell "
         "growth complete by the shortest rest where the force channel found a friction-curve cause")
@@ -239,11 +240,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     check_units(kf, model, fit.name)
     check_units(kv, model, validate.name)
     from .force import REFERENCE_GAIN, RELEVANCE, SWAP_SHARE
-    from .causes.presliding import LOOP_GAIN
+    from .causes.presliding import LOOP_GAIN, LOOP_VALIDATION_GAIN
     from .causes.dwell_loop import GATE as DWELL_GATE
     from .causes.dwell import LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
-                      reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN,
+                      reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN, loop_val_gain=LOOP_VALIDATION_GAIN,
                       dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
                       level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]

@@ -224,6 +224,16 @@ def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0,
 
 
 LOOP_GAIN = 0.5        # the loop evidence: the fitted bristles cut both records' position error by this share
+# ... the validation record's by this share, where that evidence is the bristles' or a dwell
+# growth's (:func:`loop_evidence`, :func:`~hunting.diagnose.causes.dwell_loop.verdict`): fitted on
+# the fitting record, the loop's cut there is in sample and the validation record's out of sample,
+# smaller for a true effect (reporting20 d0505's bristles: 58 % and 49 %; d0323: 93 % and 39 %;
+# reporting15 d0609's dwell growth: 88 % and 40 %). Set on development records whose fitting cut
+# passed LOOP_GAIN (reporting13, 14, 17-20): clean ones cut the validation record's error by at
+# most -1.6 % (12 records), ones whose truth has neither bristles nor a dwell growth by at most
+# 32 % (reporting19 d0607, cogging + saturation); of 917 clean records none passed the dwell
+# growth's fitting bar.
+LOOP_VALIDATION_GAIN = 0.4
 LOOP_STEPS = 2.0       # ... with a presliding range Fs / sigma0 of at least this many sensor steps
 LOOP_STEP = 0.5        # [decades] the loop fit's grid of log10 sigma0
 LOOP_EVALS = 18        # re-simulations the loop fit may spend
@@ -232,9 +242,9 @@ LOOP_EVALS = 18        # re-simulations the loop fit may spend
 def loop_evidence(fit, val, model) -> dict:
     """The second form of presliding's evidence, where the creep test has none: LuGre bristles
     whose stiffness, fitted on the fitting record's re-simulated loop (whole-record position RMS
-    error, :func:`fit_behaviour` with ``segs`` None), cut that error by at least LOOP_GAIN on both
-    records, with a presliding range Fs / sigma0 of at least LOOP_STEPS sensor steps (a quarter
-    of :func:`stiffest`'s sigma0, whose range is half a step).
+    error, :func:`fit_behaviour` with ``segs`` None), cut that error by at least LOOP_GAIN and the
+    validation record's by LOOP_VALIDATION_GAIN, with a presliding range Fs / sigma0 of at least
+    LOOP_STEPS sensor steps (a quarter of :func:`stiffest`'s sigma0, whose range is half a step).
 
     Bristles stiff enough that a rest never shows creep beyond the sensor's counts still change
     the loop where it turns or stops: friction builds up over a slip of Fs / sigma0 (5-40 um on
@@ -269,14 +279,14 @@ def loop_evidence(fit, val, model) -> dict:
     v0, v1 = position_rms_error(val, model), position_rms_error(val, extend(model, theta, {}))
     gain_v = 1.0 - v1 / v0 if np.isfinite(v0) and v0 > 0 else -np.inf
     out["val"] = (v0, v1)
-    if gain_v < LOOP_GAIN:
+    if gain_v < LOOP_VALIDATION_GAIN:
         return dict(out, reason=(f"LuGre bristles fitted on the fitting record's loop (sigma0 = {sigma0:.3g} N/m, "
                                  f"{gain_f:.1%} there) cut the validation record's position error by {gain_v:.1%} "
-                                 f"({LOOP_GAIN:.0%} needed)"))
+                                 f"({LOOP_VALIDATION_GAIN:.0%} needed)"))
     return dict(out, evidence=(f"the loop re-simulated with LuGre bristles (sigma0 fitted on the fitting record's "
                                f"position) follows both records better: position RMS error -{gain_f:.0%} fitting, "
-                               f"-{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} on both needed, where no creep "
-                               "shows at rest)"))
+                               f"-{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} "
+                               "needed, where no creep shows at rest)"))
 
 
 def creep_error(q_sim: np.ndarray, q: np.ndarray, segs) -> float:
