@@ -673,14 +673,17 @@ def _tests(lib: Library, current: Explanation, noise_v, floor: float) -> tuple[d
 
 
 def _irrelevant(t: dict) -> bool:
-    """Whether a member's force change is below its :func:`relevance_floor`."""
+    """Whether a member's force change is below its :func:`relevance_floor` (rows without the two
+    entries, built by hand, are not judged by it)."""
     return t.get("change", np.inf) < t.get("relevance", 0.0)
 
 
 def relevance_floor(model: NominalModel, name: str) -> float:
     """The smallest force change [N] (RMS on the validation record's sliding samples) that cause
-    ``name`` must make to be named: ``RELEVANCE`` times the mean of the nominal model's Coulomb
-    levels for a change of the friction force itself (``FRICTION_FORCE`` causes), 0 for the others
+    ``name`` must make to be named: ``RELEVANCE`` times the mean of the Coulomb levels of
+    ``model`` (the model the force channel extends: the nominal one, or its extension by the
+    causes found on the fitting record where alternate blocks of the validation record are
+    searched) for a change of the friction force itself (``FRICTION_FORCE`` causes), 0 for the others
     (dynamics, ripple: their size has no common scale with the friction level; a true 2 ms delay
     of reporting20 d0306 moved a stiff servo's force by 0.35 % of Fc)."""
     if not getattr(CAUSES[name], "FRICTION_FORCE", False):
@@ -837,9 +840,9 @@ def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) 
             out.append(f"along the noise-free loop the parts of {', '.join(names)} together explain {g:.1%} of "
                        f"the validation residual (< {least:.1%}): measured, they cancel each other")
     if _irrelevant(t):
-        out.append(f"its force change ({t['change']:.2g} N RMS on the sliding samples) is below {RELEVANCE:.1%} of the "
-                   f"Coulomb level ({t['relevance']:.2g} N): a change of the friction force that small is no cause "
-                   "(friction is neither known nor steady to better than that)")
+        out.append(f"its force change ({t['change']:.3g} N RMS on the validation record's sliding samples) is below "
+                   f"{t['relevance']:.3g} N, {RELEVANCE:.1%} of the mean Coulomb level: a change of the friction force "
+                   "that small is no cause (friction is neither known nor steady to better than that)")
     if 0.0 <= t["rms_without"] - t["rms"] <= t["floor"]:     # a cause that makes it worse has its reason above
         removed = (f"it removes {t['rms_without'] - t['rms']:.2g} N RMS of the validation residual, not more than "
                    f"{PRECISION:g} of the drive force's RMS ({t['floor']:.2g} N)")

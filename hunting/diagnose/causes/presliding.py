@@ -223,7 +223,8 @@ def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0,
     return np.array([10.0 ** -best]), cache[best]
 
 
-LOOP_GAIN = 0.5        # the loop evidence: the fitted bristles cut both records' position error by this share
+LOOP_GAIN = 0.5        # the loop evidence: the fitted bristles cut the fitting record's position error by this
+#                        share (the loop channel and the loop admission: both records')
 # ... the validation record's by this share, where that evidence is the bristles' or a dwell
 # growth's (:func:`loop_evidence`, :func:`~hunting.diagnose.causes.dwell_loop.verdict`): fitted on
 # the fitting record, the loop's cut there is in sample and the validation record's out of sample,
