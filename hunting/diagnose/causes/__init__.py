@@ -19,8 +19,8 @@ it), ``EXCLUDES`` (causes it cannot be combined with), ``NOISE_FED`` (its regres
 measured derivatives: judged also along a noise-free instrument trajectory), ``JUDGED_FIRST``
 (an own-evidence cause whose evidence reads only the measured records, judged before the other
 channels so that their re-simulations run on its extension), ``FRICTION_FORCE`` (a change of the
-friction force itself, a constant or a map of the velocity: its size is judged against the
-Coulomb level, :func:`hunting.diagnose.force.relevance_floor`). Adding a cause is
+friction force's level or curve, a constant or a map of the velocity: its size is judged against
+the Coulomb level, :func:`hunting.diagnose.force.relevance_floor`). Adding a cause is
 adding a module and listing it here."""
 from ..model import NominalModel
 from ...models.friction import DirectionalCurve

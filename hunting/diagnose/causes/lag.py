@@ -22,7 +22,6 @@ from ._words import _q
 NAME = "lag"
 DESCRIPTION = "frictional memory: the Stribeck level lags the velocity (time constant)"
 FAMILY = "velocity"
-FRICTION_FORCE = True   # a change of the friction force (its memory of the velocity): sized against Fc
 HYPERS = 1
 HYPER_KEYS = ("tau",)
 NOISE_FED = True      # its regressor is a map of the measured velocity, which feedback fills with noise
