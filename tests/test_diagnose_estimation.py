@@ -789,10 +789,20 @@ def test_a_true_friction_change_just_above_the_relevance_floor_is_still_named():
     """reporting18 d0429: a Stribeck change (the dip's velocity moved) whose force change on the
     validation record's sliding samples is 0.39 % of Fc, the smallest among the true
     friction-curve findings of the development sets: it stays named."""
+    from hunting.diagnose.causes import stribeck
+    from hunting.diagnose.force import relevance_floor
     fit, val, model, truth = _dataset("reporting18", 429)
     d = diagnose(fit, model, val, behaviour=False)
     assert "stribeck" in [c.name for c in d.causes], [(c.name, c.parameters) for c in d.causes]
     assert [e["cause"] for e in truth["effects"]] == ["stribeck"]
+    # the record probes the floor: its force change, recomputed from the cause's own design on the
+    # validation kinematics (not the library's fitted part), lies within 2 floors of it
+    c = next(c for c in d.causes if c.name == "stribeck")
+    kv = d.kin_val
+    f = stribeck.design(kv, model, c.hyper) @ c.theta + stribeck.shift(kv, model, c.hyper)
+    ok = np.isfinite(f) & kv.moving
+    change = float(np.sqrt(np.mean(f[ok] ** 2)))
+    assert 1.0 < change / relevance_floor(model, "stribeck") < 2.0
 
 
 def test_relevance_floor_is_sized_on_the_coulomb_level_for_friction_force_causes_only():

@@ -433,10 +433,11 @@ def static_reading(e: np.ndarray, model, speeds, evidence: str) -> dict:
     from . import stribeck
     unseen = 0.5 * float(np.percentile(speeds, 2)) if speeds is not None and speeds.size >= 10 else None
     # each direction at its own dip's velocity; one without a dip below the sliding speeds
-    vs = [float(c.vs) if c.Fs > c.Fc or unseen is None else unseen
-          for c in (model.curve.positive, model.curve.negative)]
+    curves = (model.curve.positive, model.curve.negative)
+    dips = [c.Fs > c.Fc for c in curves]
+    vs = [float(c.vs) if dip or unseen is None else unseen for c, dip in zip(curves, dips)]
     hyper = {"vs": vs[0], "vs_neg": vs[1], "dip": True}
-    where = ("at the model's Stribeck velocity" if all(c.Fs > c.Fc for c in (model.curve.positive, model.curve.negative))
+    where = ("at the model's Stribeck velocity" if all(dips)
              else "the Stribeck velocity of a direction without a dip an upper bound: below the sliding speeds, "
                   "which show no dip")
     g, sig, loo = _constant_fit(e, np.ones_like(e))
