@@ -77,7 +77,11 @@ FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.C
 SHORT = ("test",)
 TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
                "saturation")
-MAX_ATTEMPTS = 8
+# A draw is redrawn (next attempt) when its loop is unstable or never moves. Raising the bound
+# leaves every earlier set as it was: their draws all succeeded below the old bound, 8. A strong
+# hidden saturation (42 % of the unsaturated peak |u|) can stay below the break-away force for
+# 8 draws in a row (reporting22 d0339 moved on its ninth).
+MAX_ATTEMPTS = 24
 VERSION = 2
 
 
