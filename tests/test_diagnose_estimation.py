@@ -505,6 +505,37 @@ def test_dwell_with_few_fitting_rests_is_judged_over_both_records():
     assert d.causes[0].parameters["gain"] == pytest.approx(truth["effects"][0]["params"]["gain"], rel=0.25)
 
 
+def test_dwell_with_few_validation_rests_is_judged_over_both_records():
+    """reporting21 d0492: a dwell growth of 0.136 N (time 39 ms) with 6 rests ending in motion in
+    the fitting record and 1 in the validation record (3 needed to judge on it alone): left
+    untested before. Pooled like a short fitting record, the rests suggest a growth and the loop
+    re-simulated with it follows both records better: named, gain within 10 %."""
+    fit, val, model, truth = _dataset("reporting21", 492)
+    d = diagnose(fit, model, val, causes=["dwell"], behaviour=False)
+    assert [c.name for c in d.causes] == ["dwell"], (d.rejected, d.untested)
+    assert d.causes[0].parameters["gain"] == pytest.approx(truth["effects"][0]["params"]["gain"], rel=0.10)
+
+
+def test_dwell_growth_the_rests_resolve_out_of_sample_is_named_before_a_static_level():
+    """reporting21 d0380: a dwell growth of 0.43 N (time 0.12 s) on a Coulomb-viscous nominal
+    model, 6 rests of 0.15-0.65 s (3 per direction), all breaking away above Fs. The growth test
+    cannot reach alpha on them and the excess was named a higher static level (stribeck). The
+    growth fitted on the other rests predicts each rest's excess to under half the level's error:
+    dwell is named, the static level listed as the same evidence's other reading, and the
+    break-away after the longest rest within 10 % of the truth's."""
+    fit, val, model, truth = _dataset("reporting21", 380)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["dwell"], [(c.name, c.parameters) for c in d.causes]
+    c = d.causes[0]
+    assert "the growth fitted on the others predicts each rest's" in c.gain["evidence"]
+    alt = next(a for a in d.alternatives if a["name"] == "stribeck")
+    assert alt["kind"] == "same evidence" and alt["replaces"] == "dwell"
+    p, true = c.parameters, truth["effects"][0]["params"]
+    longest = 0.646
+    grown = p["level"] + p["gain"] * (1 - np.exp(-longest / p["time"]))
+    assert grown == pytest.approx(true["gain"] * (1 - np.exp(-longest / true["time"])), rel=0.10)
+
+
 def test_dwell_the_growth_test_misses_is_named_on_the_loop():
     """reporting15 d0394: a dwell growth of 1.01 N (time 0.43 s) whose break-away readings rise
     with the rest too weakly for the growth test (p = 0.17; nothing was named). The growth fitted

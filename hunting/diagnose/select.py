@@ -83,8 +83,10 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts that record's "
         "position error by at least {loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; a break-away excess every rest of both records shows (at least "
         "{level_rests} rests, both directions, all above the model's static force and {level_share:.0%} of them by at "
-        "least {level_ratio:g} times their reading's error scale): a static level higher by it (stribeck), or a dwell "
-        "growth complete by the shortest rest where the force channel found a friction-curve cause")
+        "least {level_ratio:g} times their reading's error scale): a dwell growth where, fitted on the other rests "
+        "(at least {min_rests}), it predicts each rest's excess to at most {growth_share:g} times the error of a level "
+        "raised after every rest; else a static level higher by it (stribeck), or a dwell growth complete by the "
+        "shortest rest where the force channel found a friction-curve cause")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -242,11 +244,12 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     from .force import REFERENCE_GAIN, RELEVANCE, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN, LOOP_VALIDATION_GAIN
     from .causes.dwell_loop import GATE as DWELL_GATE
-    from .causes.dwell import LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS
+    from .causes.dwell import GROWTH_SHARE, LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS, MIN_RESTS
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN, loop_val_gain=LOOP_VALIDATION_GAIN,
                       dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
-                      level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE)
+                      level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE,
+                      min_rests=MIN_RESTS, growth_share=GROWTH_SHARE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
@@ -881,7 +884,9 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     with its cause's ``name``), named unless
     ``found(rivals)`` says the force channel found a cause of the family of one of the verdict's
     ``rivals`` (dwell's break-away level: a higher static level, unless the sliding data fixed the
-    curve's; :func:`_found_family`), the first reading then its alternative. Returns (Cause, the
+    curve's; :func:`_found_family`), the first reading then its alternative; or a second reading
+    the first one beat, ``also``, listed as its alternative (dwell's resolved growth against the
+    static level, :func:`hunting.diagnose.causes.dwell.resolved_growth`). Returns (Cause, the
     alternative reading or None, extended model) or (None, rejected row, model)."""
     v = mod.judge(fit, val, kf, kv, model, can_sim, resolution)
     first = _own_failure(v, alpha, min_gain)
@@ -890,9 +895,9 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
         if second is None:
             v, first = v["otherwise"], None
             if "instead" in v and not found(v.get("rivals", ())):
-                v = dict(v["instead"], alternative=dict(
-                    name=mod.NAME, kind="same evidence", replaces=v["instead"]["name"], parameters=v["parameters"],
-                    bic_difference=None, gain=dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"])))
+                v = dict(v["instead"], alternative=_reading(v, mod.NAME, v["instead"]["name"]))
+            elif "also" in v:
+                v = dict(v, alternative=_reading(v["also"], v["also"]["name"], mod.NAME))
         else:
             first = f"{first}; and {second}"
     row = dict(name=mod.NAME, step="own", statistic=v.get("statistic"), p_value=v.get("p_value"))
@@ -907,6 +912,13 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
                   v["parameters"], v["sigma"], gain, increments=v.get("increments", {}),
                   family=getattr(CAUSES[name], "FAMILY", name)),
             v.get("alternative"), v["model"])
+
+
+def _reading(v: dict, name: str, replaces: str) -> dict:
+    """The alternative row of a second reading ``v`` (a verdict) of a named cause's own evidence:
+    cause ``name`` read in place of ``replaces``, kind "same evidence"."""
+    return dict(name=name, kind="same evidence", replaces=replaces, parameters=v["parameters"], bic_difference=None,
+                gain=dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"]))
 
 
 def _found_family(names, found: list) -> bool:
