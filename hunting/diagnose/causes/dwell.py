@@ -30,8 +30,8 @@ honesty; the old test regressed the
 validation excess minus the fitting mean on the predicted growth without an intercept, so a level
 that differed between the records passed for growth or hid it). Gain, out of sample: the RMS of
 e on the validation data's rests, nominal (the model's break-away force) against extended. A fitting
-record with fewer than MIN_RESTS rests (a short record, or one whose programme hardly stops) is
-judged on the rests of both records instead, each predicted by the growth fitted on the others
+record with fewer than MIN_RESTS rests (a short record, or one whose programme hardly stops), or a
+validation record with fewer than MIN_VALIDATION, is judged on the rests of both records instead, each predicted by the growth fitted on the others
 (leave-one-out; the parameters are then fitted on all of them): reporting10 d0324, d0436 and
 d0506 had 2 to 4 fitting rests beside 5 to 9 validation rests and were left untested."""
 import numpy as np
@@ -379,7 +379,9 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
     of their rests reached was at most 1.72; on the true records of reporting13-19 the share rule
     fires on 16 more (all with a Stribeck, level or dwell change), on none fewer.
 
-    Two readings of the same excess (the verdict holds the dwell one and, as ``instead``, the
+    Where the rests resolve a growth out of sample (:func:`resolved_growth`), the verdict is that
+    growth, the static-level reading its second one (``also``). Otherwise two readings of the same
+    excess (the verdict holds the dwell one and, as ``instead``, the
     static-level one; :func:`hunting.diagnose.select._own_channel` names the second unless the
     force channel found a cause of the friction-curve family, ``rivals``, whose static level the
     sliding data already fixed): a static level Fs higher by the excess (:func:`static_reading`),
