@@ -521,8 +521,9 @@ def test_dwell_growth_the_rests_resolve_out_of_sample_is_named_before_a_static_l
     model, 6 rests of 0.15-0.65 s (3 per direction), all breaking away above Fs. The growth test
     cannot reach alpha on them and the excess was named a higher static level (stribeck). The
     growth fitted on the other rests predicts each rest's excess to under half the level's error:
-    dwell is named, the static level listed as the same evidence's other reading, and the
-    break-away after the longest rest within 10 % of the truth's."""
+    dwell is named, the static level listed as the same evidence's other reading. Its parameters
+    come from the fitting record's loop, which follows that record better than the rests' fit
+    (level 0.06 N, gain 0.35 N): gain and time within 5 % of the truth's."""
     fit, val, model, truth = _dataset("reporting21", 380)
     d = diagnose(fit, model, val, behaviour=False)
     assert [c.name for c in d.causes] == ["dwell"], [(c.name, c.parameters) for c in d.causes]
@@ -530,10 +531,9 @@ def test_dwell_growth_the_rests_resolve_out_of_sample_is_named_before_a_static_l
     assert "the growth fitted on the others predicts each rest's" in c.gain["evidence"]
     alt = next(a for a in d.alternatives if a["name"] == "stribeck")
     assert alt["kind"] == "same evidence" and alt["replaces"] == "dwell"
+    assert "fitted on the fitting record's re-simulated loop" in c.gain["evidence"]
     p, true = c.parameters, truth["effects"][0]["params"]
-    longest = 0.646
-    grown = p["level"] + p["gain"] * (1 - np.exp(-longest / p["time"]))
-    assert grown == pytest.approx(true["gain"] * (1 - np.exp(-longest / true["time"])), rel=0.10)
+    assert p["gain"] == pytest.approx(true["gain"], rel=0.05) and p["time"] == pytest.approx(true["time"], rel=0.05)
 
 
 def test_dwell_the_growth_test_misses_is_named_on_the_loop():
