@@ -528,7 +528,7 @@ def test_dwell_growth_the_rests_resolve_out_of_sample_is_named_before_a_static_l
     d = diagnose(fit, model, val, behaviour=False)
     assert [c.name for c in d.causes] == ["dwell"], [(c.name, c.parameters) for c in d.causes]
     c = d.causes[0]
-    assert "the growth fitted on the others predicts each rest's" in c.gain["evidence"]
+    assert "the growth fitted on the others beside a level per direction predicts each rest's" in c.gain["evidence"]
     alt = next(a for a in d.alternatives if a["name"] == "stribeck")
     assert alt["kind"] == "same evidence" and alt["replaces"] == "dwell"
     assert "fitted on the fitting record's re-simulated loop" in c.gain["evidence"]

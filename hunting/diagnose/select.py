@@ -27,9 +27,10 @@ The rule (stated in every report, :data:`RULE`):
   nominal model, the others are judged on its extension, so that their re-simulations run the
   loop the machine has; where it fails there, it is judged again in its place, on their
   extension. A verdict may read its evidence twice (dwell's break-away excess after every rest:
-  a higher static level, named ``stribeck``, or a dwell growth complete by the shortest rest);
-  the cause with nothing unseen in it is named unless the force channel found a cause of its
-  rival's family, and the other is listed as an alternative (:func:`_own_channel`);
+  a growth the rests resolve out of sample, named first; otherwise a higher static level, named
+  ``stribeck``, or a dwell growth complete by the shortest rest, the cause with nothing unseen in
+  it named unless the force channel found a cause of its rival's family); the other reading is
+  listed as an alternative, unless the force channel fixed the static level (:func:`_own_channel`);
 - stick-channel causes (``CHANNEL = "stick"``: presliding) are judged on the samples where the
   (force-extended) model says the mass sticks: a chi-square test of the motion there against the
   sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
@@ -83,10 +84,11 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "gives p < {dwell_gate:g} but fails, when the growth fitted on the fitting record's loop cuts that record's "
         "position error by at least {loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; a break-away excess every rest of both records shows (at least "
         "{level_rests} rests, both directions, all above the model's static force and {level_share:.0%} of them by at "
-        "least {level_ratio:g} times their reading's error scale): a dwell growth where, fitted on the other rests "
-        "(at least {min_rests}), it predicts each rest's excess to at most {growth_share:g} times the error of a level "
-        "raised after every rest; else a static level higher by it (stribeck), or a dwell growth complete by the "
-        "shortest rest where the force channel found a friction-curve cause")
+        "least {level_ratio:g} times their reading's error scale): a dwell growth where at least {min_rests} rests "
+        "(two per direction) give a rising growth that, fitted on the others beside a level per direction, predicts "
+        "each rest's excess to at most {growth_share:g} times the error of a level per direction alone; else a static "
+        "level higher by it (stribeck), or a dwell growth complete by the shortest rest where the force channel found "
+        "a friction-curve cause")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -249,7 +251,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN, loop_val_gain=LOOP_VALIDATION_GAIN,
                       dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
                       level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE,
-                      min_rests=MIN_RESTS, growth_share=GROWTH_SHARE)
+                      min_rests=MIN_RESTS + 1, growth_share=GROWTH_SHARE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]
@@ -885,8 +887,9 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     ``found(rivals)`` says the force channel found a cause of the family of one of the verdict's
     ``rivals`` (dwell's break-away level: a higher static level, unless the sliding data fixed the
     curve's; :func:`_found_family`), the first reading then its alternative; or a second reading
-    the first one beat, ``also``, listed as its alternative (dwell's resolved growth against the
-    static level, :func:`hunting.diagnose.causes.dwell.resolved_growth`). Returns (Cause, the
+    the first one beat, ``also``, listed as its alternative unless ``found(rivals)`` (dwell's
+    resolved growth against the static level,
+    :func:`hunting.diagnose.causes.dwell.resolved_growth`). Returns (Cause, the
     alternative reading or None, extended model) or (None, rejected row, model)."""
     v = mod.judge(fit, val, kf, kv, model, can_sim, resolution)
     first = _own_failure(v, alpha, min_gain)
@@ -896,7 +899,7 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
             v, first = v["otherwise"], None
             if "instead" in v and not found(v.get("rivals", ())):
                 v = dict(v["instead"], alternative=_reading(v, mod.NAME, v["instead"]["name"]))
-            elif "also" in v:
+            elif "also" in v and not found(v.get("rivals", ())):
                 v = dict(v, alternative=_reading(v["also"], v["also"]["name"], mod.NAME))
         else:
             first = f"{first}; and {second}"
