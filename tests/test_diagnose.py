@@ -256,7 +256,8 @@ def test_emps_default_columns_show_the_mismatch(tmp_path):
 
 def test_bad_input_gets_one_clear_error(tmp_path):
     """Missing or dropped columns, ragged rows, NaN, time running backwards or in the wrong unit
-    (1 MHz), a record too short to split: each an error naming what to change."""
+    (1 MHz), a record too short to split, a mass that never moves: each an error naming what to
+    change."""
     m = generate(TruePlant(), duration=2.0)
     save_csv(m, tmp_path / "d.csv")
     back = load(tmp_path / "d.csv")
@@ -280,6 +281,12 @@ def test_bad_input_gets_one_clear_error(tmp_path):
         diagnose(replace(m, t=m.t / 1000), nominal, replace(m, t=m.t / 1000))
     with pytest.raises(SystemDefinitionError, match="too few to split"):
         diagnose(m.part(0.0, 0.2), nominal)
+    # a record at rest (within a sensor step): "does not move", not a units disagreement (the
+    # quantization's flicker read as sliding samples: reporting21 d0380's first 0.4 s got that)
+    res = 1e-6
+    still = Measurement(m.t, res * np.round(1e-7 * np.sin(50 * m.t) / res), 0.01 * np.sin(3 * m.t), q_ref=0 * m.t)
+    with pytest.raises(SystemDefinitionError, match="does not move: its position spans"):
+        diagnose(still, nominal.replace(resolution=res), m)
     with pytest.raises(SystemDefinitionError, match="loop bandwidth"):
         slow = Measurement(m.t[::40] * 1.0, m.q[::40], m.u[::40], q_ref=m.q_ref[::40])
         diagnose(slow, nominal.replace(controller=dict(nominal.controller, sample_time=None)), slow)

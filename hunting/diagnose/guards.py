@@ -103,6 +103,26 @@ SAME_DATA_NOTE = ("the validation data are the fitting data ({}): the out-of-sam
                   "and is not out of sample; give a separate record with --validate (or none: the last 40 % of DATA)")
 
 
+MIN_MOTION_STEPS = 2.0     # a record whose position spans no more sensor steps than this does not move
+
+
+def check_motion(meas: Measurement, model: NominalModel) -> None:
+    """An error when the record's position never leaves a band of MIN_MOTION_STEPS sensor steps
+    (the model's resolution, or the step read from the data) plus the sensor's noise band: the
+    mass does not move, and the force balance has nothing to show (the sliding-sample guards would
+    read the quantization's flicker as motion: a record at rest was reported as disagreeing in its
+    units)."""
+    from .resimulate import resolution_of
+    step = model.resolution if model.resolution is not None else resolution_of(meas.q)
+    band = MIN_MOTION_STEPS * max(float(step or 0.0), 0.0) + 4.0 * float(model.sensor_noise or 0.0)
+    span = float(np.ptp(meas.q))
+    if not span > band:
+        raise SystemDefinitionError(
+            f"{meas.name}: the mass does not move: its position spans {span:.3g} m over {meas.t[-1] - meas.t[0]:.3g} s, "
+            f"within {MIN_MOTION_STEPS:g} sensor steps ({float(step or 0.0):.3g} m each) and the noise band; friction "
+            "shows only in motion: give a record in which the machine moves")
+
+
 def check_units(kin, model: NominalModel, name: str) -> None:
     """An error when the model's inertia force m a or friction force F(v) on the sliding samples
     is more than MAX_FORCE_RATIO times the measured drive force: the data and the model then

@@ -214,7 +214,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .data import same_record
-    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_saturation, check_units
+    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_motion, check_saturation, check_units
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -228,6 +228,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             raise SystemDefinitionError(f"{fit.name}: {fit.n} samples are too few to split into fitting and validation "
                                         "parts (need >= 250, or give validation data)")
         fit, validate = _split(fit)
+    for meas in (fit, validate):
+        check_motion(meas, model)
     notes: list = list(check_inputs(fit, validate, model))
     if same:
         notes.append(SAME_DATA_NOTE.format(validate.name))
