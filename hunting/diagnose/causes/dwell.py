@@ -481,9 +481,8 @@ def resolved_growth(t, e, s, model) -> dict | None:
         return None
     growth = float(np.sqrt(np.mean(_left_out_directions(t, e, s, lo) ** 2)))
     level = np.empty_like(e)
-    for g in sides:
-        for k in g:
-            level[k] = e[k] - (np.sum(e[g]) - e[k]) / (g.size - 1)
+    for g in sides:                        # each rest less the mean of the others in its direction
+        level[g] = _constant_fit(e[g], np.ones(g.size))[2]
     level_error = float(np.sqrt(np.mean(level ** 2)))
     if not (level_error > 0 and growth <= GROWTH_SHARE * level_error):
         return None
