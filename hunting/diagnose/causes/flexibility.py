@@ -17,6 +17,8 @@ UNITS = {"load_mass": "kg", "frequency": "Hz", "damping": "", "stiffness": "N/m"
 DAMPING = (0.02, 0.05, 0.1, 0.2, 0.4)
 DAMPING_MAX = (0.002, 1.0)            # the damping ratios the refinement may reach
 NOISE_MARGIN = 100.0                  # the acceleration power above the encoder noise's, in the band
+SCAN_PER_OCTAVE = 4                   # the band scan's frequencies per octave (hypers)
+SCAN_BOX = (1.2, 2.0)                 # a scan candidate's range: frequency and damping ratio within these factors
 
 
 def hypers(kin, model) -> list:
@@ -55,22 +57,50 @@ def hypers(kin, model) -> list:
             return np.inf
         val, th = fit(z)
         return val if th > 0 else np.inf
+    def refined(crit, z0):
+        """z0 refined by Nelder-Mead under ``crit``, or None where the fit runs to the edge of the
+        admissible set (it has found no resonance there)."""
+        # outside the admissible set: a finite penalty (inf - inf would be NaN in the simplex test)
+        cap = 1e6 * crit(z0)
+        res = minimize(lambda z: min(crit(z), cap), z0, method="Nelder-Mead",
+                       options=dict(xatol=1e-3, fatol=1e-9, maxiter=80))
+        z = res.x if res.fun <= crit(z0) else z0
+        f0, zeta = float(np.exp(z[0])), float(np.exp(z[1]))
+        if zeta > 0.95 * DAMPING_MAX[1] or zeta < 1.05 * DAMPING_MAX[0] or f0 < 1.02 * lo or f0 > 0.98 * hi:
+            return None
+        return {"frequency": f0, "damping": zeta}
     out = []
     for i in idx:
         grid = [(np.log(fb[i] * s), np.log(zeta)) for s in np.linspace(0.8, 1.2, 9) for zeta in DAMPING]
         z0 = min(grid, key=ss)
-        if not np.isfinite(ss(z0)):
-            continue                                  # no positive load mass fits near this peak
-        # outside the admissible set: a finite penalty (inf - inf would be NaN in the simplex test)
-        cap = 1e6 * ss(z0)
-        res = minimize(lambda z: min(ss(z), cap), z0, method="Nelder-Mead",
-                       options=dict(xatol=1e-3, fatol=1e-9, maxiter=80))
-        z = res.x if res.fun <= ss(z0) else z0
-        f0, zeta = float(np.exp(z[0])), float(np.exp(z[1]))
-        # a fit that runs to the edge of the admissible set has found no resonance there
-        if zeta > 0.95 * DAMPING_MAX[1] or zeta < 1.05 * DAMPING_MAX[0] or f0 < 1.02 * lo or f0 > 0.98 * hi:
-            continue
-        out.append({"frequency": f0, "damping": zeta})
+        if np.isfinite(ss(z0)):                       # else no positive load mass fits near this peak
+            out.append(refined(ss, z0))
+    out = [h for h in out if h is not None]
+    # the band scan's best per damping ratio, refined near its grid point only (freed, it runs into
+    # the best peak's basin), where no candidate is within SCAN_BOX of it
+    box = np.log(SCAN_BOX)
+    for z0 in _scan(ss, lo, hi):
+        h = refined(lambda z, z0=z0: ss(z) if np.all(np.abs(np.asarray(z) - z0) <= box) else np.inf, z0)
+        if h is not None and all(abs(np.log(h["frequency"] / g["frequency"])) > box[0]
+                                 or abs(np.log(h["damping"] / g["damping"])) > box[1] for g in out):
+            out.append(h)
+    return out
+
+
+def _scan(ss, lo: float, hi: float) -> list:
+    """For each damping ratio of DAMPING, the best (log frequency, log damping) of a geometric grid
+    of SCAN_PER_OCTAVE frequencies per octave inside the band (lo, hi) [Hz] under the criterion
+    ``ss`` (inf where no positive load mass fits); those where one fits."""
+    if hi <= lo * 1.2:
+        return []
+    freqs = np.geomspace(lo * 1.05, hi / 1.05, max(2, int(np.ceil(np.log2(hi / lo) * SCAN_PER_OCTAVE)) + 1))
+    out = []
+    for zeta in DAMPING:
+        grid = [(np.log(f), np.log(zeta)) for f in freqs]
+        vals = [ss(z) for z in grid]
+        k = int(np.argmin(vals))
+        if np.isfinite(vals[k]):
+            out.append(grid[k])
     return out
 
 
