@@ -26,7 +26,16 @@ def hypers(kin, model) -> list:
     residual's spectrum (Welch) in the band where a resonance can be seen (:func:`band`), the
     best of a +-20 % frequency grid times the damping ratios in DAMPING, refined by least squares
     in (log frequency, log damping) with the load mass eliminated (variable projection) on the
-    moving samples, with the regressor -H(s) a (the sliding mask applied after the filter)."""
+    moving samples, with the regressor -H(s) a (the sliding mask applied after the filter).
+
+    Besides them, the band scanned (:func:`_scan`): per damping ratio of DAMPING the best of
+    SCAN_PER_OCTAVE frequencies per octave, refined within SCAN_BOX of its grid point, where no
+    candidate lies that near. A resonance above the loop's bandwidth, which the motion hardly
+    excites, makes no peak in the residual's spectrum: the load's lag shows as a broad rise
+    (reporting22 d0321: 14.8 Hz behind a 5 Hz loop, its peak candidate 18.1 Hz at damping 0.45,
+    and delay, lag and mass reported in its place). The fitting residual alone does not rank the
+    candidates (there 14.5 Hz at damping 0.1 or 0.2 left 0.73 or 0.66 of the residual's square sum,
+    17 Hz at 0.4 left 0.63): the selection's joint fit and validation test do."""
     from scipy.optimize import minimize
     from scipy.signal import find_peaks, welch
     from ..kinematics import residual
