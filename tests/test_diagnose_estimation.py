@@ -893,3 +893,18 @@ def test_relevance_floor_is_sized_on_the_coulomb_level_for_friction_force_causes
     small = dict(t, change=0.0089, p_reference=0.5)
     assert _fails(small, 1e-3, 0.05, 0.01) and not reference_only(small, 1e-3, 0.05, 0.01)
     assert reference_only(dict(small, change=0.0091), 1e-3, 0.05, 0.01)
+
+
+def test_a_drive_below_the_coulomb_friction_is_said_where_the_force_channel_is_skipped(noise_free):
+    """reporting22 d0561: the controller saturates at +-1.02 N, below the model's Coulomb friction
+    (1.66 N; Fs 2.79 N), and the mass moves 50 um in either record: the force channel is skipped
+    for too few sliding samples, and the report says why there are so few (the saturation is
+    named). A record that slides has no such note (the noise-free clean record)."""
+    from hunting.diagnose.guards import check_breakaway
+    fit, val, model, truth = _dataset("reporting22", 561)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["saturation"], [(c.name, c.parameters) for c in d.causes]
+    skipped = [i for i, n in enumerate(d.notes) if n.startswith("force channel skipped")]
+    said = [n for n in d.notes if "never exceeds 1.017 N" in n and "Coulomb friction 1.663 N" in n]
+    assert skipped and len(said) == 2, d.notes
+    assert check_breakaway(noise_free[:2], noise_free[2]) == []

@@ -214,7 +214,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     q_ref); progress : optional callable progress(stage: str, done: int, total: int) called as
     the work advances (the CLI draws a bar with it)."""
     from .data import same_record
-    from .guards import SAME_DATA_NOTE, check_controller, check_inputs, check_motion, check_saturation, check_units
+    from .guards import (SAME_DATA_NOTE, check_breakaway, check_controller, check_inputs, check_motion,
+                         check_saturation, check_units)
     names = list(CAUSES) if causes is None else list(causes)
     bad = [c for c in names if c not in CAUSES]
     if bad:
@@ -300,6 +301,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
                    f"validation data, fewer than {MIN_WINDOWS}: the smoothed residual has about that many independent "
                    "values")
             notes.append(f"force channel skipped: {why}")
+            notes += check_breakaway((fit,) if same else (fit, validate), model)
         fc = dict(causes=[], nominal=None, extended=None, rejected=[], alternatives=[], explanations=[], model=model,
                   r_fit=nan_f, r_val_nom=nan_v, r_val_ext=nan_v)
         if force_names:
