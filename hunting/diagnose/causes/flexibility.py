@@ -66,6 +66,7 @@ def hypers(kin, model) -> list:
             return np.inf
         val, th = fit(z)
         return val if th > 0 else np.inf
+
     def refined(crit, z0):
         """z0 refined by Nelder-Mead under ``crit``, or None where the fit runs to the edge of the
         admissible set (it has found no resonance there)."""
@@ -78,6 +79,7 @@ def hypers(kin, model) -> list:
         if zeta > 0.95 * DAMPING_MAX[1] or zeta < 1.05 * DAMPING_MAX[0] or f0 < 1.02 * lo or f0 > 0.98 * hi:
             return None
         return {"frequency": f0, "damping": zeta}
+
     out = []
     for i in idx:
         grid = [(np.log(fb[i] * s), np.log(zeta)) for s in np.linspace(0.8, 1.2, 9) for zeta in DAMPING]
