@@ -903,7 +903,9 @@ def test_a_drive_below_the_coulomb_friction_is_said_where_the_force_channel_is_s
     """reporting22 d0561: the controller saturates at +-1.02 N, below the model's Coulomb friction
     (1.66 N; Fs 2.79 N), and the mass moves 50 um in either record: the force channel is skipped
     for too few sliding samples, and the report says why there are so few (the saturation is
-    named). A record that slides has no such note (the noise-free clean record)."""
+    named). A record that slides has no such note (the noise-free clean record), and neither has
+    one whose force channel runs: reporting16 d0509, a true Coulomb level 0.6 times the model's,
+    slides on a drive below the model's Fc in both records, and its level change is the finding."""
     from hunting.diagnose.guards import check_breakaway
     fit, val, model, truth = _dataset("reporting22", 561)
     d = diagnose(fit, model, val, behaviour=False)
@@ -912,3 +914,8 @@ def test_a_drive_below_the_coulomb_friction_is_said_where_the_force_channel_is_s
     said = [n for n in d.notes if "never exceeds 1.017 N" in n and "Coulomb friction 1.663 N" in n]
     assert skipped and len(said) == 2, d.notes
     assert check_breakaway(noise_free[:2], noise_free[2]) == []
+    fit, val, model, truth = _dataset("reporting16", 509)
+    assert len(check_breakaway((fit, val), model)) == 2
+    d = diagnose(fit, model, val, behaviour=False, causes=["level"])
+    assert [c.name for c in d.causes] == ["level"]
+    assert not any("never exceeds" in n for n in d.notes), d.notes

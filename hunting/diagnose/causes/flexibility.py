@@ -84,9 +84,9 @@ def hypers(kin, model) -> list:
     for i in idx:
         grid = [(np.log(fb[i] * s), np.log(zeta)) for s in np.linspace(0.8, 1.2, 9) for zeta in DAMPING]
         z0 = min(grid, key=ss)
-        if np.isfinite(ss(z0)):                       # else no positive load mass fits near this peak
-            out.append(refined(ss, z0))
-    out = [h for h in out if h is not None]
+        h = refined(ss, z0) if np.isfinite(ss(z0)) else None   # none: no positive load mass fits near this peak
+        if h is not None:
+            out.append(h)
     # the band scan's best per damping ratio, refined near its grid point only (freed, it runs into
     # the best peak's basin), where no candidate is within SCAN_BOX of it
     box = np.log(SCAN_BOX)
