@@ -805,6 +805,36 @@ def test_the_loop_channel_names_only_the_best_candidate_on_the_fitting_record(mo
     assert "cuts the validation record's position error by 20.0%" in reasons["level"]
 
 
+@pytest.mark.parametrize("index, key, rel", [(513, "Fs", 0.01), (387, "vs", 0.05)])
+def test_a_stribeck_change_on_a_record_too_slow_for_the_force_channel_is_judged_on_the_loop(index, key, rel):
+    """reporting23 d0513 (the dip Fs - Fc 11 % lower) and d0387 (vs 1.4 times higher): loops that
+    barely slide, whose force channel is skipped, and which the start code left unnamed or named
+    presliding. The Stribeck curve's two loop forms (the static level at the nominal shape, the
+    Stribeck velocity) fitted on the fitting record's loop: the true change is named, its
+    parameter close to the truth, on the loop's evidence."""
+    fit, val, model, truth = _dataset("reporting23", index)
+    assert truth["causes"] == ["stribeck"] and truth["effects"][0]["variant"] == key
+    d = diagnose(fit, model, val, causes=["stribeck", "level", "offset"], behaviour=False)
+    assert [c.name for c in d.causes] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
+    c = d.causes[0]
+    assert c.hyper["evidence"] == "loop" and "too few sliding samples" in c.gain["evidence"]
+    assert c.parameters[key] == pytest.approx(truth["effects"][0]["params"][key], rel=rel)
+    assert d.extended_model.curve.positive.Fs == pytest.approx(c.parameters["Fs"])
+    assert d.extended_model.curve.positive.vs == pytest.approx(c.parameters["vs"])
+
+
+def test_a_stribeck_change_that_follows_only_the_fitting_loop_is_not_named():
+    """reporting21 d0288 (clean, the force channel skipped): a Stribeck change fitted on the
+    fitting record's loop cuts its position error by 81 %, and makes the validation record's twice
+    as large. The validation record holds the bar: nothing is named."""
+    fit, val, model, truth = _dataset("reporting21", 288)
+    assert truth["causes"] == []
+    d = diagnose(fit, model, val, causes=["stribeck"], behaviour=False)
+    assert d.causes == []
+    (row,) = [r for r in d.rejected if r["name"] == "stribeck"]
+    assert row["step"] == "loop" and "validation record's position error" in row["reason"]
+
+
 def test_a_delay_the_reference_check_cannot_confirm_is_judged_on_the_loop():
     """reporting15 d0488, a transport delay of 4.2 ms: significant on the validation residual, but
     its prediction along the noise-free reference trajectory does not hold (the check against the

@@ -393,14 +393,14 @@ def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalM
     untested += [dict(name=n, reason=why) for n in names if n not in tried]
     out = dict(rejected=[dict(name=r["name"], step="loop", statistic=None, p_value=None, validation_gain=None,
                               reason=f"{why}; and {r['reason']}") for r in v["rejected"]])
-    out["alternatives"] = [dict(name=r["name"], kind="loop", parameters=_loop_parameters(r, model)[0],
+    out["alternatives"] = [dict(name=r["name"], kind="loop", parameters=loop_channel.parameters(r["key"], model, r["x"])[0],
                                 gain=dict(metric=LOOP_METRIC + ", in place of " + v["cause"]["name"],
                                           nominal=r["val"][0], extended=r["val"][1]))
                            for r in v["alternatives"]]
     r = v["cause"]
     out["causes"] = [] if r is None else [_loop_cause(r, model, loop_channel.evidence_text(r), r["gain_fit"], None)]
     if r is not None:
-        out["model"] = loop_channel.extended(r["name"], model, r["x"])
+        out["model"] = loop_channel.extended(r["key"], model, r["x"])
     return out
 
 
@@ -408,23 +408,17 @@ def _loop_cause(r: dict, model: NominalModel, evidence: str, statistic, p_value)
     """The Cause of a loop verdict ``r`` (:func:`hunting.diagnose.loop_channel.judge`) on ``model``:
     its parameters final values, the validation position error its gain, ``evidence`` its rule in
     words."""
+    from . import loop_channel
     mod = CAUSES[r["name"]]
-    pars, inc = _loop_parameters(r, model)
+    pars, inc = loop_channel.parameters(r["key"], model, r["x"])
+    theta, hyper = loop_channel.coefficients(r["key"], model, r["x"])
     before, after = r["val"]
     return Cause(r["name"], before / max(after, 1e-300) - 1, statistic, p_value, pars, {k: None for k in pars},
-                 dict(metric=LOOP_METRIC, nominal=before, extended=after, evidence=evidence), {"evidence": "loop"},
-                 np.array([r["x"]]), inc, getattr(mod, "FAMILY", mod.NAME))
+                 dict(metric=LOOP_METRIC, nominal=before, extended=after, evidence=evidence),
+                 dict(hyper, evidence="loop"), theta, inc, getattr(mod, "FAMILY", mod.NAME))
 
 
 LOOP_METRIC = "re-simulated position RMS error [m], validation"
-
-
-def _loop_parameters(r: dict, model: NominalModel) -> tuple[dict, dict]:
-    """(final parameters, increments) of a loop verdict ``r``'s one coefficient on ``model``."""
-    mod = CAUSES[r["name"]]
-    pars = mod.parameters(np.array([r["x"]]), {}, model)
-    base = mod.parameters(np.zeros(1), {}, model)
-    return pars, {k: float(pars[k] - base[k]) for k in pars}
 
 
 def _loop_admission(fc: dict, fit: Measurement, validate: Measurement) -> dict:
@@ -462,7 +456,7 @@ def _loop_admission(fc: dict, fit: Measurement, validate: Measurement) -> dict:
            "where the loop's reaction to its own noise cannot pass for it")
     out["causes"] = list(fc["causes"]) + [_loop_cause(r, fc["model"], loop_channel.evidence_text(r, why),
                                                       row["statistic"], row["p_value"])]
-    out["model"] = loop_channel.extended(r["name"], fc["model"], r["x"])
+    out["model"] = loop_channel.extended(r["key"], fc["model"], r["x"])
     return out
 
 
