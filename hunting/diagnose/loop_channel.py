@@ -87,8 +87,9 @@ def coefficients(key: str, model: NominalModel, x: float) -> tuple[np.ndarray, d
     ``parameters``: theta = [x] without hyper-parameters for the one-coefficient causes; for a
     Stribeck curve, its static level alone at the nominal shape (``stribeck``: the ``dip``
     variant, theta = [x (Fs - Fc)], the smaller dip of the two directions) or its Stribeck
-    velocities (``stribeck vs``: the levels held, theta = [0, 0], vs and vs_neg times exp(x)). A record that barely slides shows the
-    Stribeck curve where the loop sticks and breaks away, not along a sliding curve (reporting23
+    velocities (``stribeck vs``: the levels held, theta = [0, 0], vs and vs_neg times exp(x)). A
+    record that barely slides shows the Stribeck curve where the loop sticks and breaks away, not
+    along a sliding curve (reporting23
     d0387, d0443, d0513: the force channel skipped, the true change of vs or Fs - Fc cut the
     re-simulated position error by 31-97 %)."""
     pos, neg = model.curve.positive, model.curve.negative
