@@ -807,7 +807,7 @@ def test_the_loop_channel_names_only_the_best_candidate_on_the_fitting_record(mo
 
 @pytest.mark.parametrize("index, key, rel", [(513, "Fs", 0.01), (387, "vs", 0.05)])
 def test_a_stribeck_change_on_a_record_too_slow_for_the_force_channel_is_judged_on_the_loop(index, key, rel):
-    """reporting23 d0513 (the dip Fs - Fc 11 % lower) and d0387 (vs 1.4 times higher): loops that
+    """reporting23 d0513 (the dip Fs - Fc 11 % lower) and d0387 (vs 3.9 times the nominal): loops that
     barely slide, whose force channel is skipped, and which the start code left unnamed or named
     presliding. The Stribeck curve's two loop forms (the static level at the nominal shape, the
     Stribeck velocity) fitted on the fitting record's loop: the true change is named, its
