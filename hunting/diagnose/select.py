@@ -393,7 +393,8 @@ def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalM
     untested += [dict(name=n, reason=why) for n in names if n not in tried]
     out = dict(rejected=[dict(name=r["name"], step="loop", statistic=None, p_value=None, validation_gain=None,
                               reason=f"{why}; and {r['reason']}") for r in v["rejected"]])
-    out["alternatives"] = [dict(name=r["name"], kind="loop", parameters=loop_channel.parameters(r["key"], model, r["x"])[0],
+    out["alternatives"] = [dict(name=r["name"], kind="loop",
+                                parameters=loop_channel.parameters(r["key"], model, r["x"])[0],
                                 gain=dict(metric=LOOP_METRIC + ", in place of " + v["cause"]["name"],
                                           nominal=r["val"][0], extended=r["val"][1]))
                            for r in v["alternatives"]]
