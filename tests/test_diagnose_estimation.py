@@ -668,6 +668,27 @@ def test_break_away_excess_after_every_rest_is_a_static_level_with_dwell_its_alt
     assert any(n.startswith("stribeck is named from the dwell cause's own evidence") for n in d.notes)
 
 
+def test_break_away_excess_the_sliding_samples_contradict_as_a_static_level_is_dwell():
+    """reporting24 d0352: a dwell growth of 6.15 N in 73 ms; the 14 rests last 0.13-2.6 s, each
+    breaks away about 5.8 N above Fs, and no growth is resolved. The static-level reading (Fs
+    raised at the model's own Stribeck velocity) makes the force residual on the sliding samples
+    of both records 10 % larger: the sliding friction is the model's, so the excess is the
+    break-away's alone and dwell is named (the start code named stribeck), its gain within 10 %
+    of the truth, the static level its alternative of the same evidence."""
+    from hunting.diagnose.causes.dwell import SLIDING_WORSE
+    fit, val, model, truth = _dataset("reporting24", 352)
+    assert truth["causes"] == ["dwell"] and model.curve.positive.Fs > model.curve.positive.Fc
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["dwell"], [(c.name, c.parameters) for c in d.causes]
+    c = d.causes[0]
+    assert c.parameters["gain"] == pytest.approx(truth["effects"][0]["params"]["gain"], rel=0.1)
+    assert d.extended_model.dwell.gain == pytest.approx(c.parameters["gain"])
+    worse = float(c.gain["evidence"].split("records grows by ")[1].split("%")[0]) / 100
+    assert worse >= SLIDING_WORSE
+    alt = next(a for a in d.alternatives if a["name"] == "stribeck")
+    assert alt["kind"] == "same evidence" and alt["replaces"] == "dwell"
+
+
 def test_break_away_excess_where_a_stribeck_change_is_untested_names_the_static_level():
     """reporting9 d0317: a Stribeck change (a higher Fs) on a record with too few sliding samples
     for the force channel. Every break-away is higher: the static level is named from the rests

@@ -29,7 +29,8 @@ The rule (stated in every report, :data:`RULE`):
   extension. A verdict may read its evidence twice (dwell's break-away excess after every rest:
   a growth the rests resolve out of sample, named first; otherwise a higher static level, named
   ``stribeck``, or a dwell growth complete by the shortest rest, the cause with nothing unseen in
-  it named unless the force channel found a cause of its rival's family); the other reading is
+  it named unless the force channel found a cause of its rival's family or the sliding samples
+  contradict it, :func:`hunting.diagnose.causes.dwell.sliding_contradiction`); the other reading is
   listed as an alternative, unless the force channel fixed the static level (:func:`_own_channel`);
 - stick-channel causes (``CHANNEL = "stick"``: presliding) are judged on the samples where the
   (force-extended) model says the mass sticks: a chi-square test of the motion there against the
@@ -88,7 +89,8 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "(two per direction) give a rising growth that, fitted on the others beside a level per direction, predicts "
         "each rest's excess to at most {growth_share:g} times the error of a level per direction alone; else a static "
         "level higher by it (stribeck), or a dwell growth complete by the shortest rest where the force channel found "
-        "a friction-curve cause")
+        "a friction-curve cause or where that static level makes the force residual on the sliding samples of both "
+        "records at least {sliding_worse:.0%} larger")
 CRITERION = RULE
 METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
                "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
@@ -249,12 +251,12 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     from .force import REFERENCE_GAIN, RELEVANCE, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN, LOOP_VALIDATION_GAIN
     from .causes.dwell_loop import GATE as DWELL_GATE
-    from .causes.dwell import GROWTH_SHARE, LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS, MIN_RESTS
+    from .causes.dwell import GROWTH_SHARE, LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS, MIN_RESTS, SLIDING_WORSE
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN, loop_val_gain=LOOP_VALIDATION_GAIN,
                       dwell_gate=DWELL_GATE, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
                       level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE,
-                      min_rests=MIN_RESTS + 1, growth_share=GROWTH_SHARE)
+                      min_rests=MIN_RESTS + 1, growth_share=GROWTH_SHARE, sliding_worse=SLIDING_WORSE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]
     stick_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "stick"]
     own_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "own"]

@@ -55,6 +55,8 @@ LEVEL_RATIO = 3.0      # a rest's excess over its reading's error scale, for a b
 LEVEL_SHARE = 0.8      # ... in at least this share of the rests (every one above the model's static force)
 LEVEL_FLOOR = 0.02     # of Fs: the smallest error scale of a break-away reading
 GROWTH_SHARE = 0.5     # a growth resolved out of sample: its leave-one-out error at most this share of a level's
+SLIDING_WORSE = 0.05   # a static-level reading whose sliding force residual grows this much is contradicted
+MIN_SLIDING = 100      # sliding samples of both records for that judgement (the force channel's minimum)
 
 
 def rests(meas, model, resolution: float, level: np.ndarray | None = None
@@ -342,6 +344,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     level = level_verdict(t_all, F_all, s_all, np.concatenate([scale, scale_v]), model, sliding_speeds(kf, kv))
     if level is not None and "also" in level and out.get("fitted_on") == "loop":
         level = _loop_growth(level, out, record, fit, t_all, F_all, s_all)
+    if level is not None and "instead" in level:
+        level = sliding_contradiction(level, model, kf, kv)
     if level is not None:
         return dict(out, otherwise=level)
     return out if loop is None else dict(out, otherwise=loop)
@@ -411,9 +415,10 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
     excess (the verdict holds the dwell one and, as ``instead``, the
     static-level one; :func:`hunting.diagnose.select._own_channel` names the second unless the
     force channel found a cause of the friction-curve family, ``rivals``, whose static level the
-    sliding data already fixed): a static level Fs higher by the excess (:func:`static_reading`),
+    sliding data already fixed, or :func:`judge` found the sliding data contradict the static
+    level, :func:`sliding_contradiction`): a static level Fs higher by the excess (:func:`static_reading`),
     the reading with nothing unseen in it, or a dwell growth complete by the shortest rest (time =
-    t_min / 5, an upper bound: 99 % grown there) with its gain fitted. Either gain out of sample:
+    t_min / 5, 99 % grown there: an assumption, not a measurement) with its gain fitted. Either gain out of sample:
     each rest's excess predicted by the others (leave-one-out), against the model's break-away
     force."""
     from ..model import Dwell
@@ -441,13 +446,58 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
     d = ext.dwell
     evidence = f"{above}; no growth with the rest resolved (rests of {t.min():.3g}-{t.max():.3g} s)"
     return dict(statistic=ratio, p_value=None, significant=True, rivals=("stribeck",),
-                evidence=f"{evidence}: the growth is complete by the shortest rest, its time an upper bound",
+                evidence=(f"{evidence}: the growth taken as complete by the shortest rest (its time set to a fifth of "
+                          "it, not resolved by these rests)"),
                 parameters={"level": d.level, "gain": d.gain, "time": d.time},
                 sigma={"level": None, "gain": sig, "time": None},
                 metric=(f"break-away force RMS error [N], each of the {t.size} rests of both records predicted by the "
                         "others (a break-away excess the same after every rest)"),
                 nominal=float(np.sqrt(np.mean(e ** 2))), extended=float(np.sqrt(np.mean(loo ** 2))), model=ext,
                 instead=static_reading(e, model, speeds, evidence))
+
+
+def sliding_contradiction(level: dict, model, kf, kv) -> dict:
+    """The break-away level verdict ``level`` (:func:`level_verdict`, with its static-level
+    reading ``instead``) with the dwell reading named and the static level its alternative
+    (``also``) where the sliding samples contradict the static level; else ``level`` unchanged.
+
+    A higher static level Fs raises the friction curve at low sliding speeds too; a dwell effect
+    raises only the break-away force. Where the force the static-level reading predicts on the
+    samples the force channel judges (``kf.moving``, ``kv.moving``: both records, at least
+    MIN_SLIDING of them; none of them entered its fit, which read the rests alone) leaves a force
+    residual whose RMS is at least SLIDING_WORSE larger than the model's, the sliding friction is
+    the model's and the excess is the break-away's alone (reporting24 d0352: 14 rests 5.8 N above
+    Fs, all longer than 1.8 growth times, the sliding residual 10 % larger with Fs raised; d0436:
+    0.0009 N RMS against 0.08 N). On the true Stribeck and level changes of reporting20-24 where
+    the reading applies it grew that RMS by at most 2.6 %.
+
+    Only where both directions of the model's curve have a dip: the static level is then read at
+    their own Stribeck velocities. Without a dip its velocity is an upper bound below the sliding
+    speeds (:func:`static_reading`), and a residual it grows may say that velocity is too high,
+    not that the level is wrong (reporting22 d0331: Fs 12.4 N above a curve without a dip at
+    vs = 1.3 mm/s, read 13.3 N higher at a higher velocity, grew it by 9 %)."""
+    curves = (model.curve.positive, model.curve.negative)
+    if kf is None or kv is None or not all(c.Fs > c.Fc for c in curves):
+        return level
+    from ..kinematics import residual
+    r0, r1 = [], []
+    for k in (kf, kv):
+        a, b = residual(k, model), residual(k, level["instead"]["model"])
+        use = k.moving & np.isfinite(a) & np.isfinite(b)
+        r0.append(a[use])
+        r1.append(b[use])
+    r0, r1 = np.concatenate(r0), np.concatenate(r1)
+    if r0.size < MIN_SLIDING:
+        return level
+    worse = float(np.sqrt(np.mean(r1 ** 2) / max(np.mean(r0 ** 2), 1e-300))) - 1
+    if worse < SLIDING_WORSE:
+        return level
+    why = (f"with the static level raised the force residual on the {r0.size} sliding samples of both records grows "
+           f"by {worse:.1%} (rule: >= {SLIDING_WORSE:.0%}): the sliding friction is the model's, the excess the "
+           "break-away's alone")
+    static = dict(level["instead"], evidence=f"{level['instead']['evidence']}; but {why}")
+    named = {k: v for k, v in level.items() if k != "instead"}
+    return dict(named, evidence=f"{level['evidence']}; {why}", also=static)
 
 
 def resolved_growth(t, e, s, model) -> dict | None:
