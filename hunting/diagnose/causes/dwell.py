@@ -468,8 +468,11 @@ def sliding_contradiction(level: dict, model, kf, kv) -> dict:
     residual whose RMS is at least SLIDING_WORSE larger than the model's, the sliding friction is
     the model's and the excess is the break-away's alone (reporting24 d0352: 14 rests 5.8 N above
     Fs, all longer than 1.8 growth times, the sliding residual 10 % larger with Fs raised; d0436:
-    0.0009 N RMS against 0.08 N). On the true Stribeck and level changes of reporting20-24 where
-    the reading applies it grew that RMS by at most 2.6 %.
+    0.0009 N RMS against 0.08 N). Over the 64 records of reporting20-24 where the reading applies
+    on the nominal model, it grew that RMS by 5 % or more on five: four dwell effects and a level
+    change 13 % up (reporting23 d0611), where the force channel finds the level and the excess is
+    read above it; on the diagnosis the rule changes three records, each from stribeck to the true
+    dwell.
 
     Only where both directions of the model's curve have a dip: the static level is then read at
     their own Stribeck velocities. Without a dip its velocity is an upper bound below the sliding
