@@ -28,7 +28,7 @@ The rule (stated in every report, :data:`RULE`):
   loop the machine has; where it fails there, it is judged again in its place, on their
   extension. A verdict may read its evidence twice (dwell's break-away excess after every rest:
   a growth the rests resolve out of sample, named first; otherwise a higher static level, named
-  ``stribeck``, or a dwell growth complete by the shortest rest, the cause with nothing unseen in
+  ``stribeck``, or a dwell growth from Fs fitted on the rests, the cause with nothing unseen in
   it named unless the force channel found a cause of its rival's family or the sliding samples
   contradict it, :func:`hunting.diagnose.causes.dwell.sliding_contradiction`); the other reading is
   listed as an alternative, unless the force channel fixed the static level (:func:`_own_channel`);
@@ -88,7 +88,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "least {level_ratio:g} times their reading's error scale): a dwell growth where at least {min_rests} rests "
         "(two per direction) give a rising growth that, fitted on the others beside a level per direction, predicts "
         "each rest's excess to at most {growth_share:g} times the error of a level per direction alone; else a static "
-        "level higher by it (stribeck), or a dwell growth complete by the shortest rest where the force channel found "
+        "level higher by it (stribeck), or a dwell growth from Fs fitted on the rests where the force channel found "
         "a friction-curve cause or where that static level makes the force residual on the sliding samples of both "
         "records at least {sliding_worse:.0%} larger")
 CRITERION = RULE
