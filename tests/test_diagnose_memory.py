@@ -355,6 +355,24 @@ def test_dwell_level_verdict_keeps_the_static_level_where_no_growth_is_resolved(
     assert dwell.resolved_growth(t, dwell.excess(model, t, F, s), s, model) is None
 
 
+def test_dwell_level_reading_fits_the_growth_time_the_rests_show():
+    """Five rests of 0.15-0.65 s after a growth of 0.43 N in 0.12 s (readings within 0.002 N):
+    too few for a resolved growth, so the level verdict holds the static level and the dwell
+    reading. The dwell reading's time is the one whose leave-one-out error is smallest: gain and
+    time near the truth, where a growth assumed complete by the shortest rest read the gain
+    low (its leave-one-out error is checked to be larger, brute force)."""
+    t, F, s, scale, model = _growing_rests(n=5, noise=0.002)
+    v = dwell.level_verdict(t, F, s, scale, model)
+    assert v is not None and v["instead"]["name"] == "stribeck"
+    assert v["parameters"]["gain"] == pytest.approx(0.43, rel=0.03)
+    assert v["parameters"]["time"] == pytest.approx(0.12, rel=0.3)
+    e = dwell.excess(model, t, F, s)
+    w = 1 - np.exp(-t / (t.min() / 5))
+    complete = [e[k] - w[k] * np.delete(w * e, k).sum() / np.delete(w * w, k).sum() for k in range(t.size)]
+    assert v["extended"] < 0.5 * np.sqrt(np.mean(np.square(complete)))
+    assert float(w @ e / (w @ w)) < 0.43 * 0.95          # the complete growth's gain: low
+
+
 @pytest.mark.parametrize("low, negative, holds", [(2, False, True), (3, False, False), (1, True, False)])
 def test_dwell_level_verdict_holds_on_a_share_of_the_rests_all_above_the_static_force(low, negative, holds):
     """Ten rests 1.9 N above Fs: the verdict holds where at least LEVEL_SHARE (80 %) of them
