@@ -689,6 +689,35 @@ def test_break_away_excess_the_sliding_samples_contradict_as_a_static_level_is_d
     assert alt["kind"] == "same evidence" and alt["replaces"] == "dwell"
 
 
+@pytest.mark.parametrize("index, contradicted", [(436, True), (401, False)])
+def test_the_sliding_samples_judge_the_static_level_reading_of_a_break_away_excess(index, contradicted):
+    """reporting24 d0436 (a dwell growth) and d0401 (a true Stribeck Fs change): every rest breaks
+    away above Fs with no growth resolved, and both models' curves have a dip. Against the force
+    residual on the sliding samples of both records (computed here independently of the rule's
+    code): with Fs raised by the reading, d0436's grows by orders of magnitude and the static level
+    is contradicted (dwell named, the static level its ``also``); d0401's falls by three quarters
+    and the static level stays the reading named (``instead``)."""
+    from dataclasses import replace
+
+    from hunting.diagnose.causes import dwell
+    from hunting.diagnose.resimulate import resolution_of
+    from hunting.diagnose.select import _can_simulate, default_window
+    fit, val, model, truth = _dataset("reporting24", index)
+    window = default_window(fit, val, model)
+    sensor = dict(resolution=model.resolution, noise=model.sensor_noise, steady=model.steady_slide)
+    kf, kv = (replace(k, moving=used_samples(k, model))
+              for k in (kinematics(m, model.cm, window=window, **sensor) for m in (fit, val)))
+    v = dwell.judge(fit, val, kf, kv, model, _can_simulate(fit, val, model), resolution_of(fit.q))["otherwise"]
+    static = (v["also"] if contradicted else v["instead"])["model"]
+    r0 = np.concatenate([residual(k, model)[k.moving] for k in (kf, kv)])
+    r1 = np.concatenate([residual(k, static)[k.moving] for k in (kf, kv)])
+    worse = np.sqrt(np.mean(r1 ** 2) / np.mean(r0 ** 2)) - 1
+    if contradicted:
+        assert "instead" not in v and worse > 10 and "grows by" in v["evidence"]
+    else:
+        assert "also" not in v and worse < -0.5
+
+
 def test_break_away_excess_where_a_stribeck_change_is_untested_names_the_static_level():
     """reporting9 d0317: a Stribeck change (a higher Fs) on a record with too few sliding samples
     for the force channel. Every break-away is higher: the static level is named from the rests
