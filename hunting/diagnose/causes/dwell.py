@@ -56,7 +56,7 @@ LEVEL_SHARE = 0.8      # ... in at least this share of the rests (every one abov
 LEVEL_FLOOR = 0.02     # of Fs: the smallest error scale of a break-away reading
 GROWTH_SHARE = 0.5     # a growth resolved out of sample: its leave-one-out error at most this share of a level's
 SLIDING_WORSE = 0.05   # a static-level reading whose sliding force residual grows this much is contradicted
-SATURATING_TIMES = 41   # time constants of the no-growth dwell reading's fit (:func:`_saturating_fit`)
+SATURATING_TIMES = 41  # time constants of the no-growth dwell reading's fit (:func:`_saturating_fit`)
 MIN_SLIDING = 100      # sliding samples of both records for that judgement (the force channel's minimum)
 
 
@@ -553,7 +553,7 @@ def resolved_growth(t, e, s, model) -> dict | None:
                 parameters={"level": d.level, "gain": d.gain, "time": d.time},
                 sigma=_growth_sigma(t, e, th, tau, ss, lo),
                 metric=(f"break-away force RMS error [N], each of the {t.size} rests of both records predicted by the "
-                        "growth's gain fitted on the others"),
+                        "growth fitted on the others"),
                 nominal=float(np.sqrt(np.mean(e ** 2))), extended=error, model=ext)
 
 
