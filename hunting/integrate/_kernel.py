@@ -855,14 +855,20 @@ def compiled(kind: str):
     """The kernel ``kind`` (one of KINDS: "lean", "variational" or "full"), compiled for
     KERNEL_SIG on first use. The variational kernel runs DOP853 only: give it no other method.
 
-    All compile without LLVM's loop unroller, the lean kernel without its loop vectorizer too:
-    its loops run over the states of one system (3-4 for the presets), too few for vector code
-    or unrolled copies, which took ~1.3 s and ~1-2 s of its ~12 s compile at the same run time.
-    The kernels with sensitivities loop over n (n + 1) entries and keep vector code; without
+    All compile without LLVM's loop unroller, the lean and the variational kernel without its
+    loop vectorizer too: the lean kernel's loops run over the states of one system (3-4 for the
+    presets), too few for vector code or unrolled copies, which took ~1.3 s and ~1-2 s of its
+    ~12 s compile at the same run time.
+    The kernels with sensitivities loop over n (n + 1) entries; without
     unrolled copies the full kernel compiles in ~27 instead of ~40 s CPU (with the functions it
     compiles in turn, 2 runs each) and runs as fast (flows of table 9.1 and a 4-state LuGre
     loop, DOP853 with and without sensitivities and Radau, both kernels in one process called
-    in alternation: 0.98-1.01 times the run time, bit-identical states).
+    in alternation: 0.98-1.01 times the run time, bit-identical states). The full kernel keeps
+    vector code; the variational one compiles without it too: 9.4 instead of 11.3 s wall
+    (fresh cache, one process), and the table 8.1 LuGre branch K = 0.05 -> fold -> 0.615 took
+    5.0-5.2 s against 5.2-5.5 s, a shooting of its K = 0.3 cycle 0.112-0.118 against
+    0.110-0.112 s (best of 3 and of 5, two processes each, in alternation), fold and period
+    bit-identical (2026-11-28; systems of 3-4 states, the presets' and the examples').
 
     A kernel whose cache entry is whole loads without a lock (:func:`hunting.integrate.ahead.load`);
     a compile holds the kernels' cache lock (:func:`hunting.integrate.ahead.kernel_lock`): where
@@ -870,7 +876,7 @@ def compiled(kind: str):
     disp = _DISPATCHERS[kind]
     if not disp.overloads and not ahead.load(disp, KERNEL_SIG):
         with ahead.kernel_lock(disp):
-            compile_for(disp, KERNEL_SIG, vectorize=kind != "lean", unroll=False)
+            compile_for(disp, KERNEL_SIG, vectorize=kind == "full", unroll=False)
     disp.disable_compile()
     return disp
 
