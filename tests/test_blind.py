@@ -196,6 +196,16 @@ def test_generation_is_deterministic_and_families_disjoint():
     assert f3["fit"]["q"].size != f1["fit"]["q"].size or not np.array_equal(f3["fit"]["q"], f1["fit"]["q"])
 
 
+def test_a_mass_that_creeps_within_the_resolution_is_redrawn():
+    """reporting26 d0004 (clean) was drawn with a saturation below the break-away force: its
+    mass crept 2 sensor steps, a record the diagnosis refuses. Such a draw is now redrawn, and
+    every record of the accepted draw spans at least MIN_STEPS sensor steps."""
+    files, truth, _ = generate.make("reporting26", 4)
+    assert truth["attempt"] >= 1 and any("sensor steps" in why for why in truth["rejected_draws"])
+    for name in ("fit", "val"):
+        assert np.ptp(files[name]["q"]) / truth["sensor"]["resolution"] >= generate.MIN_STEPS
+
+
 def test_level_effect_scales_both_levels_of_both_directions():
     """The ``level`` effect multiplies Fc and Fs of both directions by one factor k (viscous kept),
     up or down, from 2 % to a factor 2; its truth holds the final Fc, Fs and k, and a careful
