@@ -206,6 +206,23 @@ def test_a_mass_that_creeps_within_the_resolution_is_redrawn():
         assert np.ptp(files[name]["q"]) / truth["sensor"]["resolution"] >= generate.MIN_STEPS
 
 
+def test_stated_uncertainties_are_scored_against_the_truth():
+    """A found effect's parameter with a stated sigma gets z = |reported - true| / sigma; the
+    summary counts the share stated and, of those, the share within COVER_Z (a parameter without
+    sigma is neither covered nor missed)."""
+    effect = dict(cause="viscous", accept=["viscous"], params={"b": 10.0}, gain=0.5, frac=0.5)
+    truths = {"d1": dict(causes=["viscous"], effects=[effect]), "d2": dict(causes=["viscous"], effects=[effect]),
+              "d3": dict(causes=["viscous"], effects=[effect])}
+    results = {"d1": dict(causes=[dict(name="viscous", parameters={"b": 11.0}, sigma={"b": 0.4})], seconds=1.0),
+               "d2": dict(causes=[dict(name="viscous", parameters={"b": 10.5}, sigma={"b": 0.5})], seconds=1.0),
+               "d3": dict(causes=[dict(name="viscous", parameters={"b": 12.0})], seconds=1.0)}
+    rows = report.score(truths, results)
+    assert [r["effects"][0]["z"]["b"] for r in rows] == [pytest.approx(2.5), pytest.approx(1.0), None]
+    s = report.summary(rows)
+    assert s["params_sigma"][1:] == (2, 3) and s["params_covered"][1:] == (1, 2)
+    assert s["params"][1:] == (2, 3)
+
+
 def test_level_effect_scales_both_levels_of_both_directions():
     """The ``level`` effect multiplies Fc and Fs of both directions by one factor k (viscous kept),
     up or down, from 2 % to a factor 2; its truth holds the final Fc, Fs and k, and a careful

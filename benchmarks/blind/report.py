@@ -10,7 +10,10 @@ Scoring rules (one place, used by the report and the tests):
 - *moderate*: an effect whose validation gain when modelled exactly (``truth.json`` gain,
   computed without hunting) is at least MODERATE = 0.15;
 - parameter error: for a found effect, |reported - true| / |true| of the primary parameters
-  (``draw.PRIMARY`` of the reported name) that both the report and the truth hold.
+  (``draw.PRIMARY`` of the reported name) that both the report and the truth hold;
+- uncertainty: where the judge states a standard uncertainty sigma for such a parameter,
+  |reported - true| / sigma; the truth is *covered* when that is at most COVER_Z = 2 (about 95 %
+  of the parameters for honest, normal uncertainties).
 
 Targets (issue 17, item 7), on the reporting seeds: overall false alarms <= 5 % of the clean
 datasets and <= 1 % per cause; moderate single effects named first in >= 95 %; two-effect datasets
@@ -29,6 +32,7 @@ from . import draw
 MODERATE = 0.15
 TARGETS = dict(false_alarm=0.05, false_alarm_cause=0.01, named_first=0.95, both_found=0.90, params=0.95)
 PARAM_TOL = 0.10
+COVER_Z = 2.0
 GAIN_BINS = (-math.inf, 0.05, 0.15, 0.3, 0.6, math.inf)
 
 
@@ -58,15 +62,18 @@ def score(truths: dict, results: dict) -> dict:
         effects = []
         for e in t["effects"]:
             found = [k for k, n in enumerate(names) if n in e["accept"]]
-            errs = {}
+            errs, zs = {}, {}
             if found:
                 name, pars = rep[found[0]]
+                sig = res["causes"][found[0]].get("sigma") or {}
                 for p in draw.PRIMARY.get(name, ()):
                     if p in pars and p in e["params"] and e["params"][p] != 0:
                         errs[p] = abs(pars[p] - e["params"][p]) / abs(e["params"][p])
+                        s = sig.get(p)
+                        zs[p] = abs(pars[p] - e["params"][p]) / s if s is not None and s > 0 else None
             effects.append(dict(cause=e["cause"], variant=e.get("variant", ""), gain=e["gain"], frac=e["frac"],
                                 found=bool(found), first=bool(names) and names[0] in e["accept"],
-                                moderate=e["gain"] >= MODERATE, errors=errs))
+                                moderate=e["gain"] >= MODERATE, errors=errs, z=zs))
         rows.append(dict(id=i, causes=t["causes"], reported=names, extras=[n for n in names if n not in accepted],
                          effects=effects, error=res.get("error"), seconds=res.get("seconds", float("nan"))))
     return rows
@@ -94,6 +101,10 @@ def summary(rows: list) -> dict:
         n_moderate_pairs=len(mod_pairs),
         params=_rate(sum(all(v <= PARAM_TOL for v in e["errors"].values()) for e in found_mod), len(found_mod)),
         n_params=len(found_mod),
+        params_sigma=_rate(sum(z is not None for e in found_mod for z in e["z"].values()),
+                           sum(len(e["z"]) for e in found_mod)),
+        params_covered=_rate(sum(z <= COVER_Z for e in found_mod for z in e["z"].values() if z is not None),
+                             sum(z is not None for e in found_mod for z in e["z"].values())),
         extras_on_effects=_rate(sum(bool(r["extras"]) for r in single + pairs), len(single + pairs)),
         errors=sum(r["error"] is not None for r in rows),
         seconds=float(np.nanmedian([r["seconds"] for r in rows])) if rows else float("nan"))
@@ -167,12 +178,13 @@ def detection_by_gain(rows: list, cause: str) -> list:
 
 
 def parameter_errors(rows: list) -> dict:
-    """{cause: {parameter: [relative errors]}} of the found effects (any size)."""
+    """{cause: {parameter: [(relative error, error / stated sigma or None)]}} of the found effects
+    (any size)."""
     out: dict = {}
     for r in rows:
         for e in r["effects"]:
             for p, v in e["errors"].items():
-                out.setdefault(e["cause"], {}).setdefault(p, []).append(v)
+                out.setdefault(e["cause"], {}).setdefault(p, []).append((v, e["z"].get(p)))
     return out
 
 
@@ -274,7 +286,9 @@ def markdown(set_name: str, judged: dict, figure_name: str | None = None) -> str
                        ("both_found", "two moderate effects: both found"),
                        ("both_found_all", "two effects of any size: both found"),
                        ("extras_on_effects", "effect datasets with an extra (wrong) cause"),
-                       ("params", "found moderate causes with parameters within 10 %")):
+                       ("params", "found moderate causes with parameters within 10 %"),
+                       ("params_sigma", "their parameters with a stated standard uncertainty"),
+                       ("params_covered", f"of those, truth within {COVER_Z:g} stated uncertainties")):
         L.append(f"| {label} | " + " | ".join(f"{_pct(S[n][key][0])} ({S[n][key][1]}/{S[n][key][2]})"
                                               for n in names) + " |")
     L.append("| judge failures (exceptions) | " + " | ".join(str(S[n]["errors"]) for n in names) + " |")
@@ -311,12 +325,17 @@ def markdown(set_name: str, judged: dict, figure_name: str | None = None) -> str
     if figure_name:
         L += ["", f"![detection against effect size]({figure_name})", ""]
     L += ["", "### Parameter errors of found causes (relative to the true final value)", "",
-          "| cause | parameter | judge | n | median | within 10 % |", "|---|---|---|---|---|---|"]
+          f"Uncertainty stated: share of the values that come with a standard uncertainty; covered: of those, "
+          f"the share whose truth lies within {COVER_Z:g} of them.", "",
+          "| cause | parameter | judge | n | median | within 10 % | uncertainty stated | covered |",
+          "|---|---|---|---|---|---|---|---|"]
     for n in names:
         for c, pars in sorted(parameter_errors(judged[n]).items()):
-            for p, v in sorted(pars.items()):
-                v = np.asarray(v)
-                L.append(f"| {c} | {p} | {n} | {v.size} | {100 * np.median(v):.1f} % | {_pct(np.mean(v <= PARAM_TOL))} |")
+            for p, vz in sorted(pars.items()):
+                v = np.asarray([a for a, _ in vz])
+                z = np.asarray([b for _, b in vz if b is not None])
+                L.append(f"| {c} | {p} | {n} | {v.size} | {100 * np.median(v):.1f} % | {_pct(np.mean(v <= PARAM_TOL))} | "
+                         f"{z.size}/{v.size} | {_pct(np.mean(z <= COVER_Z)) if z.size else '-'} |")
     L += ["", "### Effect sizes (validation gain when modelled, single effects)", "",
           "| cause | n | gain >= 0.15 | median gain |", "|---|---|---|---|"]
     rows0 = judged[names[0]]

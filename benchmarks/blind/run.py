@@ -42,7 +42,7 @@ def hunting_label() -> str:
 
 def judge_hunting(dd: Path) -> dict:
     """The diagnosis on one dataset directory: selected causes in rank order with their
-    parameters, p-value, score and validation gain (the metric without and with the cause), the
+    parameters, their standard uncertainties (``sigma``; a parameter without one is left out), p-value, score and validation gain (the metric without and with the cause), the
     alternatives' names, notes, and the rejected causes' names with their reasons (what a later
     look at a miss needs, without running the diagnosis again)."""
     from hunting.diagnose import NominalModel, diagnose, load
@@ -53,7 +53,8 @@ def judge_hunting(dd: Path) -> dict:
     alts = [c["name"] for c in d.get("causes", []) if c.get("role") == "alternative"]
     alts += [a["name"] for a in d.get("alternatives", []) or [] if a["name"] not in alts]
     return dict(causes=[dict(name=c["name"], parameters=_floats(c.get("parameters", {})),
-                             p_value=c.get("p_value"), score=c.get("score"), gain=c.get("gain")) for c in selected],
+                             sigma=_floats(c.get("sigma") or {}), p_value=c.get("p_value"), score=c.get("score"),
+                             gain=c.get("gain")) for c in selected],
                 alternatives=alts, notes=d.get("notes", []), gain=d.get("gain"),
                 rejected=[dict(name=r.get("name"), reason=r.get("reason")) for r in d.get("rejected", []) or []],
                 untested=[dict(name=u.get("name"), reason=u.get("reason")) for u in d.get("untested", []) or []])
