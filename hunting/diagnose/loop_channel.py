@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SystemDefinitionError
+from . import loop_sigma
 from .causes import CAUSES
 from .causes.presliding import LOOP_GAIN
 from .data import Measurement
@@ -34,6 +35,7 @@ from .model import NominalModel
 GRID = 7             # the grid of each candidate's parameter over its span
 REFINE = 5           # bounded Brent evaluations around the grid's best point
 MAX_DELAY = 0.02     # [s] the largest delay tried
+SIGMA_STEP = 0.01    # the central difference of the fitted coefficient's uncertainty: this share of its span
 
 
 def spans(model: NominalModel, meas: Measurement) -> dict:
@@ -150,8 +152,10 @@ def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple) -> tu
 
 def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dict:
     """The loop channel's verdict on the force-channel causes ``names`` (those with a one-parameter
-    loop extension, :func:`spans`): ``cause`` (name, candidate ``key``, coefficient ``x``, the
-    fitting and validation position RMS errors nominal and extended) or None, ``alternatives``
+    loop extension, :func:`spans`): ``cause`` (name, candidate ``key``, coefficient ``x`` with its
+    ``span`` and standard uncertainty ``sigma_x`` (:func:`~hunting.diagnose.loop_sigma.coefficient_sigma`,
+    None where it cannot be estimated), the fitting and validation position RMS errors nominal and
+    extended) or None, ``alternatives``
     (the others that pass the bar, same fields), ``rejected`` (name, reason) for the candidates
     tried. A cause with two forms (:data:`FORMS`) is represented by the one that fits the fitting
     record's loop better."""
@@ -167,7 +171,7 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
         if name not in names:
             continue
         x, f1 = fit_one(key, fit, model, span)
-        r = dict(name=name, key=key, x=x, fit=(f0, f1), gain_fit=1.0 - f1 / f0)
+        r = dict(name=name, key=key, x=x, span=span, fit=(f0, f1), gain_fit=1.0 - f1 / f0)
         if name not in best or r["gain_fit"] > best[name]["gain_fit"]:
             best[name] = r
     tried = sorted(best.values(), key=lambda r: -r["gain_fit"])
@@ -185,7 +189,10 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
             r["reason"] = (f"fitted on the fitting record's loop ({r['gain_fit']:.1%} there) it cuts the validation "
                            f"record's position error by {g} ({LOOP_GAIN:.0%} needed)")
     if tried and "reason" not in tried[0]:
-        out["cause"] = tried[0]
+        r = tried[0]
+        r["sigma_x"] = loop_sigma.coefficient_sigma(fit, lambda x: extended(r["key"], model, x), r["x"],
+                                         SIGMA_STEP * (r["span"][1] - r["span"][0]))
+        out["cause"] = r
         out["alternatives"] = [r for r in tried[1:] if "reason" not in r]
     else:
         # the best on the fitting record failed: one that passes behind it was chosen by its
@@ -195,6 +202,14 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
                                    f"better ({tried[0]['gain_fit']:.1%} against {r['gain_fit']:.1%}) and failed")
     out["rejected"] = [dict(name=r["name"], reason=r["reason"]) for r in tried if "reason" in r]
     return out
+
+
+def parameter_sigma(r: dict, model: NominalModel) -> dict:
+    """{parameter: standard uncertainty} of a loop verdict's final parameters (candidate r["key"]
+    at coefficient r["x"] with standard uncertainty r["sigma_x"], :func:`judge`), by the delta
+    method; None for a parameter the coefficient does not change, or where sigma_x is None."""
+    return loop_sigma.parameter_sigma(lambda x: parameters(r["key"], model, x)[0], r["x"], r.get("sigma_x"),
+                                      1e-4 * (r["span"][1] - r["span"][0]))
 
 
 def evidence_text(r: dict, why: str = "too few sliding samples for the force balance") -> str:

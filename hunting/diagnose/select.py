@@ -64,6 +64,7 @@ from ..errors import SystemDefinitionError
 from .causes import CAUSES, untestable
 from .data import Measurement
 from .kinematics import Kinematics, kinematics, reference_kinematics, used_samples
+from .loop_sigma import parameter_sigma
 from .model import NominalModel
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
@@ -409,14 +410,15 @@ def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalM
 
 def _loop_cause(r: dict, model: NominalModel, evidence: str, statistic, p_value) -> Cause:
     """The Cause of a loop verdict ``r`` (:func:`hunting.diagnose.loop_channel.judge`) on ``model``:
-    its parameters final values, the validation position error its gain, ``evidence`` its rule in
-    words."""
+    its parameters final values with the loop fit's standard uncertainties, the validation
+    position error its gain, ``evidence`` its rule in words."""
     from . import loop_channel
     mod = CAUSES[r["name"]]
     pars, inc = loop_channel.parameters(r["key"], model, r["x"])
     theta, hyper = loop_channel.coefficients(r["key"], model, r["x"])
     before, after = r["val"]
-    return Cause(r["name"], before / max(after, 1e-300) - 1, statistic, p_value, pars, {k: None for k in pars},
+    return Cause(r["name"], before / max(after, 1e-300) - 1, statistic, p_value, pars,
+                 loop_channel.parameter_sigma(r, model),
                  dict(metric=LOOP_METRIC, nominal=before, extended=after, evidence=evidence),
                  dict(hyper, evidence="loop"), theta, inc, getattr(mod, "FAMILY", mod.NAME))
 
@@ -1020,8 +1022,9 @@ def _loop_channel(mod, fit, val, model, can_sim, test, why):
     theta = v["theta"]
     before, after = v["val"]
     pars = mod.parameters(theta, {}, model)
-    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, 1 - v["fit"][1] / v["fit"][0], None, pars,
-                  {k: None for k in pars},
+    sig = parameter_sigma(lambda lg: mod.parameters(np.array([10.0 ** -lg]), {}, model), -np.log10(theta[0]),
+                          v.get("sigma_lg"), 1e-4)
+    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, 1 - v["fit"][1] / v["fit"][0], None, pars, sig,
                   dict(metric="re-simulated position RMS error [m], validation", nominal=before, extended=after,
                        evidence=v["evidence"]), {"evidence": "loop"}, np.asarray(theta),
                   family=getattr(mod, "FAMILY", mod.NAME)),

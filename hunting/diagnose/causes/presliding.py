@@ -30,6 +30,8 @@ The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 = 
 (damping ratio 0.5 of the presliding resonance) because creeping data cannot determine it."""
 import numpy as np
 from scipy.signal import savgol_filter
+
+from ..loop_sigma import coefficient_sigma
 from ._words import _q
 
 NAME = "presliding"
@@ -238,6 +240,7 @@ LOOP_VALIDATION_GAIN = 0.4
 LOOP_STEPS = 2.0       # ... with a presliding range Fs / sigma0 of at least this many sensor steps
 LOOP_STEP = 0.5        # [decades] the loop fit's grid of log10 sigma0
 LOOP_EVALS = 18        # re-simulations the loop fit may spend
+SIGMA_DECADES = 0.05   # [decades] the central difference of the loop fit's uncertainty in log10 sigma0
 
 
 def loop_evidence(fit, val, model) -> dict:
@@ -262,8 +265,9 @@ def loop_evidence(fit, val, model) -> dict:
     record's fit lay at least 0.75 below).
 
     Returns a dict: ``theta`` [1 / sigma0], ``fit`` (nominal, extended) and ``val`` (nominal,
-    extended) position RMS errors [m], ``evidence`` (the rule's words), and ``reason`` when the
-    evidence fails."""
+    extended) position RMS errors [m], ``evidence`` (the rule's words) with ``sigma_lg`` (the
+    standard uncertainty of log10 sigma0, :func:`~hunting.diagnose.loop_sigma.coefficient_sigma`;
+    None where it cannot be estimated), and ``reason`` when the evidence fails."""
     from ..resimulate import position_rms_error
     f0 = position_rms_error(fit, model)
     bound = stiffest(model, fit) / (2.0 * LOOP_STEPS)
@@ -284,6 +288,8 @@ def loop_evidence(fit, val, model) -> dict:
         return dict(out, reason=(f"LuGre bristles fitted on the fitting record's loop (sigma0 = {sigma0:.3g} N/m, "
                                  f"{gain_f:.1%} there) cut the validation record's position error by {gain_v:.1%} "
                                  f"({LOOP_VALIDATION_GAIN:.0%} needed)"))
+    lg = -np.log10(theta[0])
+    out["sigma_lg"] = coefficient_sigma(fit, lambda x: extend(model, np.array([10.0 ** -x]), {}), lg, SIGMA_DECADES)
     return dict(out, evidence=(f"the loop re-simulated with LuGre bristles (sigma0 fitted on the fitting record's "
                                f"position) follows both records better: position RMS error -{gain_f:.0%} fitting, "
                                f"-{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} "

@@ -1,0 +1,75 @@
+"""Standard uncertainty of a coefficient fitted on the re-simulated loop.
+
+The loop channel, presliding's loop evidence and the dwell growth fit one coefficient x by the
+whole record's re-simulated position RMS error. Near the optimum x* the residual
+r(x) = q_sim(x) - q is linear in x, r(x) = r* + J (x - x*), and the least-squares estimate's
+error is (J^T J)^-1 J^T e for a residual noise e. Its variance is the long-run variance of the
+score s_t = J_t r_t over (J^T J)^2 (the sandwich estimate; it holds for the pseudo-true value of a
+model that is misspecified elsewhere, too). A loop's position residual is strongly correlated
+(a stick phase's error lasts hundreds of samples), so the long-run variance is sum(s^2) times the
+score's integrated autocorrelation time, its window chosen by Sokal's rule (the smallest lag M
+with M >= SOKAL_C times the time summed up to M). J is a central difference over ``h``, wide
+enough to step across the encoder's quantization of q_sim."""
+from __future__ import annotations
+
+import numpy as np
+
+from .data import Measurement
+
+SOKAL_C = 5.0        # Sokal's window: the smallest lag M with M >= SOKAL_C * tau(M)
+
+
+def integrated_time(s: np.ndarray) -> float:
+    """The integrated autocorrelation time tau = 1 + 2 sum_k rho_k of the series s (n,), summed
+    up to Sokal's window; at least 1, at most n (where no window up to n / 2 satisfies the rule,
+    the sum up to n / 2)."""
+    s = np.asarray(s, float) - np.mean(s)
+    n = s.size
+    if n < 4 or not np.any(s):
+        return 1.0
+    f = np.fft.rfft(s, 2 * n)
+    acov = np.fft.irfft(f * np.conj(f))[:n // 2 + 1]
+    rho = acov / acov[0]
+    tau = 1.0 + 2.0 * np.cumsum(rho[1:])
+    lags = np.arange(1, rho.size)
+    ok = np.nonzero(lags >= SOKAL_C * tau)[0]
+    t = tau[ok[0]] if ok.size else tau[-1]
+    return float(np.clip(t, 1.0, n))
+
+
+def coefficient_sigma(meas: Measurement, model_at, x: float, h: float) -> float | None:
+    """Standard uncertainty of a coefficient x fitted on the re-simulated loop of ``meas``
+    (module docstring). model_at(x) : the NominalModel at coefficient x (None where x is not a
+    physical model); h : the half step of the central difference, in x's units. None where a
+    re-simulation fails or the positions do not depend on x."""
+    from .resimulate import resimulate
+    sims = []
+    for xx in (x - h, x, x + h):
+        m = model_at(xx)
+        sim = resimulate(meas, m) if m is not None else None
+        if sim is None or not sim.ok:
+            return None
+        sims.append(sim.q)
+    n = min(q.size for q in sims)
+    r = sims[1][:n] - meas.q[:n]
+    J = (sims[2][:n] - sims[0][:n]) / (2.0 * h)
+    jj = float(J @ J)
+    if not jj > 0:
+        return None
+    s = J * r
+    return float(np.sqrt(float(s @ s) * integrated_time(s)) / jj)
+
+
+def parameter_sigma(parameters_at, x: float, sigma_x: float | None, h: float) -> dict:
+    """{parameter: standard uncertainty} of the parameters parameters_at(x) (a dict) of a
+    coefficient x with standard uncertainty sigma_x, by the delta method (a central difference
+    over h); None for a parameter x does not change, or for all where sigma_x is None."""
+    pars = parameters_at(x)
+    if sigma_x is None:
+        return {k: None for k in pars}
+    lo, hi = parameters_at(x - h), parameters_at(x + h)
+    out = {}
+    for k in pars:
+        d = (hi[k] - lo[k]) / (2.0 * h)
+        out[k] = float(abs(d) * sigma_x) if d != 0 else None
+    return out
