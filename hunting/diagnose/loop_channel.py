@@ -154,7 +154,8 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
     """The loop channel's verdict on the force-channel causes ``names`` (those with a one-parameter
     loop extension, :func:`spans`): ``cause`` (name, candidate ``key``, coefficient ``x`` with its
     ``span`` and standard uncertainty ``sigma_x`` (:func:`~hunting.diagnose.loop_sigma.coefficient_sigma`,
-    None where it cannot be estimated), the fitting and validation position RMS errors nominal and
+    or the spread against the same fit on the validation record where larger,
+    :func:`~hunting.diagnose.loop_sigma.two_records`; None where it cannot be estimated), the fitting and validation position RMS errors nominal and
     extended) or None, ``alternatives``
     (the others that pass the bar, same fields), ``rejected`` (name, reason) for the candidates
     tried. A cause with two forms (:data:`FORMS`) is represented by the one that fits the fitting
@@ -190,8 +191,10 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
                            f"record's position error by {g} ({LOOP_GAIN:.0%} needed)")
     if tried and "reason" not in tried[0]:
         r = tried[0]
-        r["sigma_x"] = loop_sigma.coefficient_sigma(fit, lambda x: extended(r["key"], model, x), r["x"],
-                                         SIGMA_STEP * (r["span"][1] - r["span"][0]))
+        sig = loop_sigma.coefficient_sigma(fit, lambda x: extended(r["key"], model, x), r["x"],
+                                           SIGMA_STEP * (r["span"][1] - r["span"][0]))
+        x_val = fit_one(r["key"], val, model, r["span"])[0] if sig is not None else None
+        r["sigma_x"] = loop_sigma.two_records(sig, r["x"], x_val)
         out["cause"] = r
         out["alternatives"] = [r for r in tried[1:] if "reason" not in r]
     else:

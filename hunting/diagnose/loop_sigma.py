@@ -9,7 +9,13 @@ model that is misspecified elsewhere, too). A loop's position residual is strong
 (a stick phase's error lasts hundreds of samples), so the long-run variance is sum(s^2) times the
 score's integrated autocorrelation time, its window chosen by Sokal's rule (the smallest lag M
 with M >= SOKAL_C times the time summed up to M). J is a central difference over ``h``, wide
-enough to step across the encoder's quantization of q_sim."""
+enough to step across the encoder's quantization of q_sim.
+
+That estimate sees the record's noise, not the model's error: where the residual is the model's
+(a loop that cannot follow the record whatever x is), the best x depends on the excitation. The
+same fit on the validation record gives a second, independent value; where the two differ by
+more than the within-record estimate says, their spread is the uncertainty
+(:func:`two_records`)."""
 from __future__ import annotations
 
 import numpy as np
@@ -37,11 +43,13 @@ def integrated_time(s: np.ndarray) -> float:
     return float(np.clip(t, 1.0, n))
 
 
-def coefficient_sigma(meas: Measurement, model_at, x: float, h: float) -> float | None:
+def coefficient_sigma(meas: Measurement, model_at, x: float, h: float, residual=None) -> float | None:
     """Standard uncertainty of a coefficient x fitted on the re-simulated loop of ``meas``
     (module docstring). model_at(x) : the NominalModel at coefficient x (None where x is not a
-    physical model); h : the half step of the central difference, in x's units. None where a
-    re-simulation fails or the positions do not depend on x."""
+    physical model); h : the half step of the central difference, in x's units; residual(q_sim)
+    : the fit's residual vector of a re-simulated position (default q_sim - meas.q; a fit on
+    parts of the record, e.g. presliding's creep in the stick segments, passes its own, linear
+    in q_sim). None where a re-simulation fails or the residual does not depend on x."""
     from .resimulate import resimulate
     sims = []
     for xx in (x - h, x, x + h):
@@ -50,9 +58,15 @@ def coefficient_sigma(meas: Measurement, model_at, x: float, h: float) -> float 
         if sim is None or not sim.ok:
             return None
         sims.append(sim.q)
-    n = min(q.size for q in sims)
-    r = sims[1][:n] - meas.q[:n]
-    J = (sims[2][:n] - sims[0][:n]) / (2.0 * h)
+    if residual is None:
+        n = min(q.size for q in sims)
+        res = [q[:n] - meas.q[:n] for q in sims]
+    else:
+        res = [np.asarray(residual(q), float) for q in sims]
+        if len({v.size for v in res}) != 1:
+            return None
+    r = res[1]
+    J = (res[2] - res[0]) / (2.0 * h)
     jj = float(J @ J)
     if not jj > 0:
         return None
@@ -73,3 +87,14 @@ def parameter_sigma(parameters_at, x: float, sigma_x: float | None, h: float) ->
         d = (hi[k] - lo[k]) / (2.0 * h)
         out[k] = float(abs(d) * sigma_x) if d != 0 else None
     return out
+
+
+def two_records(sigma: float | None, x_fit: float, x_val: float | None) -> float | None:
+    """The standard uncertainty of a loop-fitted coefficient with the validation record's own
+    fit x_val beside the fitting record's x_fit: the larger of the within-record estimate
+    ``sigma`` and |x_fit - x_val| / sqrt(2) (two independent estimates of one value differ by
+    sqrt(2) sigma on average; where they differ by more, the residual is the model's error, which
+    no within-record statistic sees, and the value depends on the excitation)."""
+    if sigma is None or x_val is None or not np.isfinite(x_val):
+        return sigma
+    return float(max(sigma, abs(x_fit - x_val) / np.sqrt(2.0)))

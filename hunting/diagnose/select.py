@@ -998,7 +998,11 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     if gain < min_gain:
         return reject(gain, f"validation gain {gain:.1%} < {min_gain:.0%}")
     pars = mod.parameters(theta, {}, model)
-    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, {k: None for k in pars},
+    sig = {k: None for k in pars}
+    if can_sim and hasattr(mod, "log_sigma0_sigma"):
+        sig = parameter_sigma(lambda lg: mod.parameters(np.array([10.0 ** -lg]), {}, model), -np.log10(theta[0]),
+                              mod.log_sigma0_sigma(fit, val, model, theta, segs, mod.segments(kv, model)), 1e-4)
+    return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, sig,
                   dict(metric=metric, nominal=before, extended=after), {}, np.asarray(theta),
                   family=getattr(mod, "FAMILY", mod.NAME)), None, ext)
 

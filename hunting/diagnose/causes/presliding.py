@@ -31,7 +31,7 @@ The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 = 
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..loop_sigma import coefficient_sigma
+from ..loop_sigma import coefficient_sigma, two_records
 from ._words import _q
 
 NAME = "presliding"
@@ -288,28 +288,49 @@ def loop_evidence(fit, val, model) -> dict:
         return dict(out, reason=(f"LuGre bristles fitted on the fitting record's loop (sigma0 = {sigma0:.3g} N/m, "
                                  f"{gain_f:.1%} there) cut the validation record's position error by {gain_v:.1%} "
                                  f"({LOOP_VALIDATION_GAIN:.0%} needed)"))
-    lg = -np.log10(theta[0])
-    out["sigma_lg"] = coefficient_sigma(fit, lambda x: extend(model, np.array([10.0 ** -x]), {}), lg, SIGMA_DECADES)
+    out["sigma_lg"] = log_sigma0_sigma(fit, val, model, theta, None, None)
     return dict(out, evidence=(f"the loop re-simulated with LuGre bristles (sigma0 fitted on the fitting record's "
                                f"position) follows both records better: position RMS error -{gain_f:.0%} fitting, "
                                f"-{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} "
                                "needed, where no creep shows at rest)"))
 
 
-def creep_error(q_sim: np.ndarray, q: np.ndarray, segs) -> float:
-    """RMS [m] of the position error q_sim - q inside the stick segments ``segs`` ((first, last)
-    index pairs), each segment's mean error removed (the creep's shape, not where the loop came
-    to rest); inf when the re-simulation q_sim (n_sim,) ends before every segment."""
+def log_sigma0_sigma(fit, val, model, theta, segs, segs_val) -> float | None:
+    """Standard uncertainty [decades] of log10 sigma0 fitted by :func:`fit_behaviour` on the
+    fitting record (theta = [1 / sigma0]; on its stick segments ``segs``, or the whole record
+    where None): the sandwich estimate on the fit's residual, or the spread against the same fit
+    on the validation record (on ``segs_val``) where that is larger
+    (:func:`~hunting.diagnose.loop_sigma.two_records`)."""
+    lg = -float(np.log10(theta[0]))
+    residual = None if segs is None else (lambda q_sim: creep_residual(q_sim, fit.q, segs))
+    sig = coefficient_sigma(fit, lambda x: extend(model, np.array([10.0 ** -x]), {}), lg, SIGMA_DECADES,
+                            residual=residual)
+    if sig is None:
+        return None
+    if segs is None:
+        th_v = fit_behaviour(val, model, None, max_evals=LOOP_EVALS, step=LOOP_STEP)[0]
+    else:
+        th_v = fit_behaviour(val, model, segs_val)[0] if segs_val else None
+    return two_records(sig, lg, None if th_v is None else -float(np.log10(th_v[0])))
+
+
+def creep_residual(q_sim: np.ndarray, q: np.ndarray, segs) -> np.ndarray:
+    """The position error q_sim - q [m] inside the stick segments ``segs`` ((first, last) index
+    pairs), each segment's mean error removed (the creep's shape, not where the loop came to
+    rest), concatenated; empty when the re-simulation q_sim (n_sim,) ends before every segment."""
     err = []
     for a, b in segs:
         b = min(b, q_sim.size - 1)
         if b > a:
             e = q_sim[a:b + 1] - q[a:b + 1]
             err.append(e - e.mean())
-    if not err:
-        return float("inf")
-    e = np.concatenate(err)
-    return float(np.sqrt(np.mean(e ** 2)))
+    return np.concatenate(err) if err else np.zeros(0)
+
+
+def creep_error(q_sim: np.ndarray, q: np.ndarray, segs) -> float:
+    """RMS [m] of :func:`creep_residual`; inf when the re-simulation ends before every segment."""
+    e = creep_residual(q_sim, q, segs)
+    return float(np.sqrt(np.mean(e ** 2))) if e.size else float("inf")
 
 
 def bristle_damping(sigma0: float, mass: float, zeta: float = ZETA) -> float:
