@@ -49,3 +49,11 @@ def test_parameter_sigma_by_the_delta_method():
     s = loop_sigma.parameter_sigma(lambda x: {"p": np.exp(x), "fixed": 3.0}, 0.5, 0.1, 1e-4)
     assert s["p"] == pytest.approx(np.exp(0.5) * 0.1, rel=1e-6) and s["fixed"] is None
     assert loop_sigma.parameter_sigma(lambda x: {"p": x}, 0.5, None, 1e-4) == {"p": None}
+
+
+def test_two_records_takes_the_larger_spread():
+    """Within-record sigma 0.1: fits 1.0 and 1.05 keep it; 1.0 and 2.0 (the model's error) give
+    1 / sqrt(2); no validation fit keeps the within-record value."""
+    assert loop_sigma.two_records(0.1, 1.0, 1.05) == 0.1
+    assert loop_sigma.two_records(0.1, 1.0, 2.0) == pytest.approx(1 / np.sqrt(2))
+    assert loop_sigma.two_records(0.1, 1.0, None) == 0.1 and loop_sigma.two_records(None, 1.0, 2.0) is None
