@@ -155,8 +155,8 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
     loop extension, :func:`spans`): ``cause`` (name, candidate ``key``, coefficient ``x`` with its
     ``span`` and standard uncertainty ``sigma_x`` (:func:`~hunting.diagnose.loop_sigma.coefficient_sigma`,
     or the spread against the same fit on the validation record where larger,
-    :func:`~hunting.diagnose.loop_sigma.two_records`; None where it cannot be estimated), the fitting and validation position RMS errors nominal and
-    extended) or None, ``alternatives``
+    :func:`~hunting.diagnose.loop_sigma.two_records`; None where it cannot be estimated), the
+    fitting and validation position RMS errors nominal and extended) or None, ``alternatives``
     (the others that pass the bar, same fields), ``rejected`` (name, reason) for the candidates
     tried. A cause with two forms (:data:`FORMS`) is represented by the one that fits the fitting
     record's loop better."""

@@ -1023,13 +1023,13 @@ def _loop_channel(mod, fit, val, model, can_sim, test, why):
         gain = (1 - v["val"][1] / v["val"][0]) if "val" in v else None
         return None, dict(name=mod.NAME, step="loop", statistic=chi2, p_value=p, validation_gain=gain,
                           reason=f"{why}; and {v['reason']}"), model
-    theta = v["theta"]
+    theta, hyper = v["theta"], v.get("hyper", {})
     before, after = v["val"]
-    pars = mod.parameters(theta, {}, model)
-    sig = parameter_sigma(lambda lg: mod.parameters(np.array([10.0 ** -lg]), {}, model), -np.log10(theta[0]),
+    pars = mod.parameters(theta, hyper, model)
+    sig = parameter_sigma(lambda lg: mod.parameters(np.array([10.0 ** -lg]), hyper, model), -np.log10(theta[0]),
                           v.get("sigma_lg"), 1e-4)
     return (Cause(mod.NAME, before / max(after, 1e-300) - 1, 1 - v["fit"][1] / v["fit"][0], None, pars, sig,
                   dict(metric="re-simulated position RMS error [m], validation", nominal=before, extended=after,
-                       evidence=v["evidence"]), {"evidence": "loop"}, np.asarray(theta),
+                       evidence=v["evidence"]), dict(hyper, evidence="loop"), np.asarray(theta),
                   family=getattr(mod, "FAMILY", mod.NAME)),
-            None, mod.extend(model, theta, {}))
+            None, mod.extend(model, theta, hyper))
