@@ -1,7 +1,8 @@
 """Standard uncertainty of a coefficient fitted on the re-simulated loop.
 
-The loop channel, presliding's loop evidence and the dwell growth fit one coefficient x by the
-whole record's re-simulated position RMS error. Near the optimum x* the residual
+The loop channel and presliding's loop evidence fit one coefficient x by the whole record's
+re-simulated position RMS error (presliding's creep fit by the error inside the stick segments,
+each segment's mean removed: a residual linear in the re-simulated position too). Near the optimum x* the residual
 r(x) = q_sim(x) - q is linear in x, r(x) = r* + J (x - x*), and the least-squares estimate's
 error is (J^T J)^-1 J^T e for a residual noise e. Its variance is the long-run variance of the
 score s_t = J_t r_t over (J^T J)^2 (the sandwich estimate; it holds for the pseudo-true value of a

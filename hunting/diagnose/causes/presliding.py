@@ -27,7 +27,9 @@ quantization and sensor noise (variance at most res^2/4 + noise^2); the chi-squa
 segment-demeaned displacement against it gives the p-value.
 
 The extension is the LuGre law with that sigma0 on the nominal curves; sigma1 = sqrt(sigma0 m)
-(damping ratio 0.5 of the presliding resonance) because creeping data cannot determine it."""
+(damping ratio 0.5 of the presliding resonance) because creeping data cannot determine it. The
+loop evidence (:func:`loop_evidence`), where no creep shows, fits the damping ratio too, from
+LOOP_ZETAS: a loop that turns and stops within the bristles' slip shows it."""
 import numpy as np
 from scipy.signal import savgol_filter
 
