@@ -162,7 +162,7 @@ class Library:
         self.Sf, self.Sv = Samples.thin(used_f, step), Samples.thin(used_v, step)
         for name in names:
             mod = CAUSES[name]
-            why = untestable(name, kf, model) or untestable(name, kv, model)
+            why = untestable(name, kf, model) or untestable(name, kv, model, validation=True)
             if why:
                 self.untested[name] = why
                 continue

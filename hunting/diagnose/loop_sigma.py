@@ -51,28 +51,58 @@ def coefficient_sigma(meas: Measurement, model_at, x: float, h: float, residual=
     : the fit's residual vector of a re-simulated position (default q_sim - meas.q; a fit on
     parts of the record, e.g. presliding's creep in the stick segments, passes its own, linear
     in q_sim). None where a re-simulation fails or the residual does not depend on x."""
+    sig = coefficients_sigma(meas, lambda v: model_at(float(v[0])), np.array([x], float), np.array([h], float),
+                             residual)
+    return None if sig is None or sig[0] is None else float(sig[0])
+
+
+def coefficients_sigma(meas: Measurement, model_at, x: np.ndarray, h: np.ndarray, residual=None) -> list | None:
+    """Standard uncertainties (k,) of coefficients x (k,) fitted together on the re-simulated
+    loop of ``meas`` (:func:`coefficient_sigma`'s estimate with a (n, k) Jacobian: bread (J^T J)^-1,
+    meat sum(s s^T) times the largest of the scores' integrated autocorrelation times; 1 + 2k
+    re-simulations). model_at(x) : the NominalModel at coefficients x (k,); h (k,) : half steps.
+    An entry is None where the residual does not depend on that coefficient; None where a
+    re-simulation fails or no coefficient moves the residual."""
     from .resimulate import resimulate
-    sims = []
-    for xx in (x - h, x, x + h):
+    x, h = np.asarray(x, float), np.asarray(h, float)
+
+    def res_at(xx):
         m = model_at(xx)
         sim = resimulate(meas, m) if m is not None else None
         if sim is None or not sim.ok:
             return None
-        sims.append(sim.q)
-    if residual is None:
-        n = min(q.size for q in sims)
-        res = [q[:n] - meas.q[:n] for q in sims]
-    else:
-        res = [np.asarray(residual(q), float) for q in sims]
-        if len({v.size for v in res}) != 1:
-            return None
-    r = res[1]
-    J = (res[2] - res[0]) / (2.0 * h)
-    jj = float(J @ J)
-    if not jj > 0:
+        return sim.q if residual is None else np.asarray(residual(sim.q), float)
+    centre = res_at(x)
+    if centre is None:
         return None
-    s = J * r
-    return float(np.sqrt(float(s @ s) * integrated_time(s)) / jj)
+    cols = []
+    for j in range(x.size):
+        step = np.zeros_like(x)
+        step[j] = h[j]
+        pair = [res_at(x + step), res_at(x - step)]
+        if any(v is None for v in pair):
+            return None
+        cols.append(pair)
+    n = min([centre.size] + [v.size for pair in cols for v in pair])
+    if residual is None:
+        r = centre[:n] - meas.q[:n]
+    elif any(v.size != centre.size for pair in cols for v in pair):
+        return None
+    else:
+        r = centre
+    J = np.column_stack([(a[:n] - b[:n]) / (2.0 * hj) for (a, b), hj in zip(cols, h)])
+    moves = np.any(J != 0, axis=0)
+    if not moves.any():
+        return None
+    Jm = J[:, moves]
+    S = Jm * r[:n, None]
+    tau = max(integrated_time(S[:, j]) for j in range(S.shape[1]))
+    bread = np.linalg.pinv(Jm.T @ Jm)
+    cov = bread @ (S.T @ S * tau) @ bread
+    out, it = [], iter(np.sqrt(np.clip(np.diag(cov), 0.0, None)))
+    for m in moves:
+        out.append(float(next(it)) if m else None)
+    return out
 
 
 def parameter_sigma(parameters_at, x: float, sigma_x: float | None, h: float) -> dict:

@@ -58,11 +58,16 @@ def hyper_count(name: str, hyper: dict) -> int:
     return int(fn(hyper)) if fn is not None else int(mod.HYPERS)
 
 
-def untestable(name: str, kin, model) -> str | None:
+def untestable(name: str, kin, model, validation: bool = False) -> str | None:
     """Why a record (its Kinematics) cannot test cause ``name`` against ``model`` (its
-    ``untestable`` hook), or None when it can or the cause has no such hook."""
-    fn = getattr(CAUSES[name], "untestable", None)
-    return fn(kin, model) if fn is not None else None
+    ``untestable`` hook), or None when it can or the cause has no such hook. ``validation``: the
+    record only judges a fit made on another, which a cause with ``ONE_WAY_VALIDATION`` (its fit
+    needs both directions of motion, its prediction either) tells its hook."""
+    mod = CAUSES[name]
+    fn = getattr(mod, "untestable", None)
+    if fn is None:
+        return None
+    return fn(kin, model, validation=True) if validation and getattr(mod, "ONE_WAY_VALIDATION", False) else fn(kin, model)
 
 
 __all__ = ["CAUSES", "hyper_count", "hyper_keys", "untestable"]

@@ -15,6 +15,7 @@ FRICTION_FORCE = True   # a change of the friction force (a constant or a map of
 HYPERS = 0
 NOISE_FED = True      # its regressor is made of measured derivatives, which feedback fills with noise
 EXCLUDES = ("viscous",)      # v = max(v, 0) + min(v, 0): viscous is the special case b+ = b-
+ONE_WAY_VALIDATION = True   # its fit needs both directions of motion, its prediction either
 NESTS = ("viscous",)        # force.select names viscous unless b+ != b- explains the validation data better
 UNITS = {"b_pos": "N s/m", "b_neg": "N s/m"}
 
@@ -23,8 +24,14 @@ def hypers(kin, model) -> list:
     return [{}]
 
 
-def untestable(kin, model) -> str | None:
-    """Both directions must be driven: at least 10 % of the sliding samples each way."""
+def untestable(kin, model, validation: bool = False) -> str | None:
+    """Both directions must be driven: at least 10 % of the sliding samples each way; a
+    validation record (``validation``) that moves one way still judges the fitted coefficient of
+    that way (reporting28 d0483: b+ 16.6 and b- 7.3 N s/m against a nominal 11.9, the fitting
+    record's sines both ways, the validation record one move: untested, the viscous change fitted
+    on both ways no change)."""
+    if validation:
+        return None
     v = kin.v[kin.moving]
     share = min(np.mean(v > 0), np.mean(v < 0)) if v.size else 0.0
     return None if share >= 0.1 else f"the record moves one way only ({share:.0%} of the sliding samples the other way)"

@@ -333,14 +333,19 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     out = _growth_verdict(t, F, s, scale, tv, Fv, sv, scale_v, model)
     loop = record = None
     if can_sim and "model" in out and out["p_value"] < dwell_loop.GATE:
-        out, record = dwell_loop.refine(out, fit, model, t if t.size >= 2 else np.concatenate([t, tv]))
+        held = t if t.size >= 2 else np.concatenate([t, tv])
+        out, record = dwell_loop.refine(out, fit, model, held, validate)
         loop = record
         # with the loop's parameters the break-away metric is theirs: a growth the readings fitted
         # and the loop does not reproduce fails there (reporting16 d0190 and d0211, clean records
         # named dwell at p < 1e-3, and the true d0366 and d0450, whose readings' gains were 70 and
         # 15 % off, are no longer named)
         out = _regained(out, tv, Fv, sv, np.concatenate([t, tv]), np.concatenate([F, Fv]), np.concatenate([s, sv]))
-        loop = dwell_loop.verdict(loop, validate, model, out["p_value"])
+        loop = dwell_loop.verdict(loop, validate, model, out["p_value"], fit_meas=fit, rest_times=held)
+    if loop is None and can_sim:
+        held = rest_durations(fit, model, resolution)
+        if held.size:
+            loop = dwell_loop.unprompted(fit, validate, model, held, _unasked(out))
     t_all, F_all, s_all = np.concatenate([t, tv]), np.concatenate([F, Fv]), np.concatenate([s, sv])
     level = level_verdict(t_all, F_all, s_all, np.concatenate([scale, scale_v]), model, sliding_speeds(kf, kv))
     if level is not None and "also" in level and out.get("fitted_on") == "loop":
@@ -350,6 +355,24 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     if level is not None:
         return dict(out, otherwise=level)
     return out if loop is None else dict(out, otherwise=loop)
+
+
+def rest_durations(meas, model, resolution: float) -> np.ndarray:
+    """Durations (m,) [s] of the rests in ``meas`` that end in motion before the record does, its
+    first rest included (the contact rested longer before the record began: a lower bound): the
+    break-aways the loop's dwell growth acts on (:func:`hunting.diagnose.causes.dwell_loop.unprompted`)."""
+    from ..behaviour import stick_phases
+    band = max(resolution, 1e-15) + 4.0 * model.sensor_noise
+    ahead = max(int(round(0.05 / meas.dt)), 2)
+    return np.array([(b - a + 1) * meas.dt for a, b in stick_phases(meas.q, meas.dt, band, window=REST_WINDOW)
+                     if b + ahead < meas.n])
+
+
+def _unasked(out: dict) -> str:
+    """Why the growth verdict ``out`` (:func:`_growth_verdict`) did not ask the loop, in words."""
+    if "p_value" in out:
+        return f"the rests' break-away readings alone show no growth (p = {out['p_value']:.2g} >= {dwell_loop.GATE:g})"
+    return f"the rests' break-away readings cannot test a growth ({out.get('reason', 'no growth fitted')})"
 
 
 def _loop_growth(level: dict, out: dict, record: dict, fit_meas, t_all, F_all, s_all) -> dict:

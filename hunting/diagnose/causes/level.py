@@ -29,6 +29,7 @@ DESCRIPTION = "friction level (Coulomb and static) scaled in both directions"
 FAMILY = "friction curve"
 FRICTION_FORCE = True   # a change of the friction force (a constant or a map of the velocity): sized against Fc
 HYPERS = 0
+ONE_WAY_VALIDATION = True     # its fit needs both directions of motion (against an offset), its prediction either
 EXCLUDES = ("stribeck",)      # both change the levels Fc and Fs; the shape change includes this one
 UNITS = {"Fc": "N", "Fs": "N", "scale": "", "Fc_neg": "N", "Fs_neg": "N"}
 
@@ -37,17 +38,18 @@ def hypers(kin, model) -> list:
     return [{}]
 
 
-def untestable(kin, model) -> str | None:
+def untestable(kin, model, validation: bool = False) -> str | None:
     """No level to scale, or a record that moves one way only (less than 10 % of the sliding
     samples the other way) against a curve without a Stribeck dip: there sign(v) g(|v|) = Fc is a
     constant force while sliding, the ``offset`` cause, and a change common to both directions
-    cannot be told from it (with a dip the regressor's shape in speed tells them apart)."""
+    cannot be told from it (with a dip the regressor's shape in speed tells them apart). A
+    validation record (``validation``) that moves one way still judges a level fitted on both."""
     pos, neg = model.curve.positive, model.curve.negative
     if pos.Fc <= 0 and neg.Fc <= 0 and pos.Fs <= 0 and neg.Fs <= 0:
         return "the nominal model has no Coulomb or static friction to scale (offset, stribeck or asymmetry add it)"
     v = kin.v[kin.moving]
     share = min(np.mean(v > 0), np.mean(v < 0)) if v.size else 0.0
-    if share < 0.1 and pos.Fs == pos.Fc and neg.Fs == neg.Fc:
+    if share < 0.1 and pos.Fs == pos.Fc and neg.Fs == neg.Fc and not validation:
         return (f"the record moves one way only ({share:.0%} of the sliding samples the other way): a level common "
                 "to both directions of a curve without a Stribeck dip is a constant force (offset) there")
     return None
