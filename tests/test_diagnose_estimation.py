@@ -643,6 +643,19 @@ def test_dwell_whose_break_away_readings_show_nothing_is_named_on_the_loop_unpro
     assert c.sigma["time"] is None
 
 
+def test_no_unprompted_dwell_beside_a_static_level_the_force_channel_moved():
+    """reporting28 d0303: a Stribeck change (Fs 15.62 N); the force channel fits Fs = 15.26 +- 0.19
+    N, and a 0.8 N growth complete within 24 ms, fitted on the loop unprompted (growth test p =
+    0.66), cut both records' position errors by 57 and 65 %: it stands for the static level's
+    error. Beside the friction-curve cause it is not named, and the rejection says why."""
+    fit, val, model, truth = _dataset("reporting28", 303)
+    assert truth["causes"] == ["stribeck"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
+    row = next(r for r in d.rejected if r["name"] == "dwell")
+    assert "cannot be told from that level's error" in row["reason"]
+
+
 def test_a_clean_record_whose_rests_hint_at_growth_gets_no_dwell_from_the_loop():
     """reporting13 d0261 (clean): the break-away readings rise with the rest at p = 0.007, not
     enough for the growth test; the growth fitted on the loop cuts the fitting record's position

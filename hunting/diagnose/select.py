@@ -84,7 +84,8 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "{loop_gain:.0%}; a noise-fed cause that fails only along the reference trajectory, when fitted on the fitting "
         "record's loop it cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
         "fails or cannot be run and the fitting record holds a break-away (the loop's fit then starts from the "
-        "readings' where they give p < {dwell_gate:g}), when the growth fitted on the fitting record's loop cuts that record's "
+        "readings' where they give p < {dwell_gate:g}; above it, not beside a friction-curve cause the force channel "
+        "found), when the growth fitted on the fitting record's loop cuts that record's "
         "position error by at least {loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; a break-away excess every rest of both records shows (at least "
         "{level_rests} rests, both directions, all above the model's static force and {level_share:.0%} of them by at "
         "least {level_ratio:g} times their reading's error scale): a dwell growth where at least {min_rests} rests "
@@ -893,12 +894,17 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     curve's; :func:`_found_family`), the first reading then its alternative; or a second reading
     the first one beat, ``also``, listed as its alternative unless ``found(rivals)`` (dwell's
     resolved growth against the static level,
-    :func:`hunting.diagnose.causes.dwell.resolved_growth`). Returns (Cause, the
+    :func:`hunting.diagnose.causes.dwell.resolved_growth`). A second form with a ``veto`` fails
+    where ``found(veto["rivals"])`` (dwell's unprompted loop growth beside a friction-curve
+    cause, :func:`hunting.diagnose.causes.dwell_loop.unprompted`). Returns (Cause, the
     alternative reading or None, extended model) or (None, rejected row, model)."""
     v = mod.judge(fit, val, kf, kv, model, can_sim, resolution)
     first = _own_failure(v, alpha, min_gain)
     if first is not None and "otherwise" in v:
         second = _own_failure(v["otherwise"], alpha, min_gain)
+        veto = v["otherwise"].get("veto")
+        if second is None and veto is not None and found(veto["rivals"]):
+            second = veto["reason"]
         if second is None:
             v, first = v["otherwise"], None
             if "instead" in v and not found(v.get("rivals", ())):
