@@ -1,6 +1,7 @@
-"""Standard uncertainty of a coefficient fitted on the re-simulated loop.
+"""Standard uncertainty of coefficients fitted on the re-simulated loop.
 
-The loop channel and presliding's loop evidence fit one coefficient x by the whole record's
+The loop channel and presliding's loop evidence fit one coefficient x (dwell's loop growth two,
+log gain and log time: :func:`coefficients_sigma`, J a matrix) by the whole record's
 re-simulated position RMS error (presliding's creep fit by the error inside the stick segments,
 each segment's mean removed: a residual linear in the re-simulated position too). Near the optimum x* the residual
 r(x) = q_sim(x) - q is linear in x, r(x) = r* + J (x - x*), and the least-squares estimate's
