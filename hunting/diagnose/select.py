@@ -915,7 +915,10 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
             first = f"{first}; and {second}"
     row = dict(name=mod.NAME, step="own", statistic=v.get("statistic"), p_value=v.get("p_value"))
     if "reason" in v:
-        return None, dict(row, validation_gain=None, reason=v["reason"], untested=bool(v.get("untestable"))), model
+        # a second form of evidence that was judged and failed makes the cause tested (its reason joined)
+        judged = "otherwise" in v
+        return None, dict(row, validation_gain=None, reason=first if judged else v["reason"],
+                          untested=bool(v.get("untestable")) and not judged), model
     if first is not None:
         return None, dict(row, validation_gain=_own_gain(v), reason=first), model
     name = v.get("name", mod.NAME)

@@ -149,7 +149,7 @@ def refine(growth: dict, fit_meas, model, rest_times, val_meas=None) -> tuple[di
 def unprompted(fit_meas, val_meas, model, rest_times, prompt: str) -> dict:
     """The loop's verdict (:func:`verdict`) where the growth test did not ask for it (module
     docstring): the growth fitted on ``fit_meas``'s loop from the grid alone (``rest_times`` (m,)
-    [s], the fitting record's rests, its first included), judged on both records; ``prompt``
+    [s], the fitting record's rests that span the time grid), judged on both records; ``prompt``
     says why the rests alone did not ask (the growth test's p or why it was not run). The verdict
     carries a ``veto``: not named where the force channel found a cause of its ``rivals``' family
     (:func:`hunting.diagnose.select._own_channel`)."""
