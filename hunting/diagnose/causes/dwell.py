@@ -373,9 +373,9 @@ def rest_durations(meas, model, resolution: float) -> np.ndarray:
 
 def _unasked(out: dict) -> str:
     """Why the growth verdict ``out`` (:func:`_growth_verdict`) did not ask the loop, in words."""
-    if "p_value" in out:
-        return f"the rests' break-away readings alone show no growth (p = {out['p_value']:.2g} >= {dwell_loop.GATE:g})"
-    return f"the rests' break-away readings cannot test a growth ({out.get('reason', 'no growth fitted')})"
+    if "reason" in out:        # too few rests, rests of one length, or a fitted growth that falls
+        return f"the rests' break-away readings show no growth ({out['reason']})"
+    return f"the rests' break-away readings alone show no growth (p = {out['p_value']:.2g} >= {dwell_loop.GATE:g})"
 
 
 def _loop_growth(level: dict, out: dict, record: dict, fit_meas, t_all, F_all, s_all) -> dict:
