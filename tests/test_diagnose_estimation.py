@@ -656,6 +656,19 @@ def test_no_unprompted_dwell_beside_a_static_level_the_force_channel_moved():
     assert "cannot be told from that level's error" in row["reason"]
 
 
+def test_dwell_loop_verdict_without_static_friction_fails_instead_of_raising(monkeypatch):
+    """A model with no static friction has no break-away to grow: the loop fits nothing (its model
+    stays without a dwell), and the verdict is a failure with its reason, not an AttributeError."""
+    from hunting.diagnose import resimulate
+    from hunting.diagnose.causes import dwell_loop
+    fit, val, model, _ = _dataset("reporting28", 366)
+    from hunting.models.friction import DirectionalCurve, Viscous
+    bare = model.replace(curve=DirectionalCurve(Viscous(5.0), Viscous(5.0)))
+    monkeypatch.setattr(resimulate, "position_rms_error", lambda meas, m: 1e-5)
+    v = dwell_loop.unprompted(fit, val, bare, np.array([0.1, 0.3]), "no growth read")
+    assert v["significant"] is False and "no growth could be fitted" in v["evidence"]
+
+
 def test_a_clean_record_whose_rests_hint_at_growth_gets_no_dwell_from_the_loop():
     """reporting13 d0261 (clean): the break-away readings rise with the rest at p = 0.007, not
     enough for the growth test; the growth fitted on the loop cuts the fitting record's position

@@ -61,6 +61,21 @@ def test_coefficients_sigma_matches_the_spread_of_two_correlated_estimates(monke
     assert np.median(sigmas[:, 0]) > 1.5 * np.median(single)
 
 
+def test_coefficients_sigma_is_none_for_a_coefficient_the_record_does_not_resolve(monkeypatch):
+    """A second coefficient that moves the 'loop' 1e-8 as much as the first (a dwell time every
+    rest outlasts): no finite uncertainty for it (a pseudo-inverse reported ~1e-14), while the
+    first keeps its one-coefficient value."""
+    t = np.linspace(0.0, 10.0, 2000)
+    g0, g1 = np.sin(2 * np.pi * 0.3 * t), np.cos(2 * np.pi * 0.7 * t)
+    G = np.column_stack([g0, 1e-8 * g1])
+    monkeypatch.setattr(resimulate, "resimulate", lambda meas, m: SimpleNamespace(q=G @ m, ok=True))
+    q = G @ np.array([2.0, 1.0]) + 1e-3 * np.random.default_rng(3).standard_normal(t.size)
+    x = np.array([float(g0 @ q / (g0 @ g0)), 1.0])
+    sig = loop_sigma.coefficients_sigma(SimpleNamespace(q=q), lambda v: v, x, np.full(2, 0.01))
+    one = loop_sigma.coefficient_sigma(SimpleNamespace(q=q), lambda v: np.array([v, 1.0]), x[0], 0.01)
+    assert sig[1] is None and sig[0] == pytest.approx(one, rel=1e-6)
+
+
 def test_coefficient_sigma_is_none_where_the_loop_fails_or_ignores_x(monkeypatch):
     monkeypatch.setattr(resimulate, "resimulate", lambda meas, m: SimpleNamespace(q=np.ones(10), ok=m is not None))
     meas = SimpleNamespace(q=np.zeros(10))

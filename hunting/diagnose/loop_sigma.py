@@ -25,6 +25,7 @@ import numpy as np
 from .data import Measurement
 
 SOKAL_C = 5.0        # Sokal's window: the smallest lag M with M >= SOKAL_C * tau(M)
+RESOLVED = 1e-6      # a Jacobian's singular value below this share of the largest: a direction the record does not resolve
 
 
 def integrated_time(s: np.ndarray) -> float:
@@ -62,8 +63,9 @@ def coefficients_sigma(meas: Measurement, model_at, x: np.ndarray, h: np.ndarray
     loop of ``meas`` (:func:`coefficient_sigma`'s estimate with a (n, k) Jacobian: bread (J^T J)^-1,
     meat sum(s s^T) times the largest of the scores' integrated autocorrelation times; 1 + 2k
     re-simulations). model_at(x) : the NominalModel at coefficients x (k,); h (k,) : half steps.
-    An entry is None where the residual does not depend on that coefficient; None where a
-    re-simulation fails or no coefficient moves the residual."""
+    An entry is None where the residual does not depend on that coefficient, or the coefficient
+    loads on a direction the record does not resolve (a singular value of J below RESOLVED of
+    the largest); None where a re-simulation fails or no coefficient moves the residual."""
     from .resimulate import resimulate
     x, h = np.asarray(x, float), np.asarray(h, float)
 
@@ -98,11 +100,22 @@ def coefficients_sigma(meas: Measurement, model_at, x: np.ndarray, h: np.ndarray
     Jm = J[:, moves]
     S = Jm * r[:n, None]
     tau = max(integrated_time(S[:, j]) for j in range(S.shape[1]))
-    bread = np.linalg.pinv(Jm.T @ Jm)
+    # the bread from the SVD of J: a direction whose singular value is below RESOLVED of the
+    # largest is not resolved by the record, and a coefficient that loads on it has no finite
+    # uncertainty (a pseudo-inverse would drop the direction and report it as known exactly)
+    _, sv, Vt = np.linalg.svd(Jm, full_matrices=False)
+    kept = sv > RESOLVED * sv[0]
+    V = Vt[kept].T / sv[kept]
+    bread = V @ V.T
     cov = bread @ (S.T @ S * tau) @ bread
-    out, it = [], iter(np.sqrt(np.clip(np.diag(cov), 0.0, None)))
+    unresolved = np.any(np.abs(Vt[~kept]) > 1e-3, axis=0) if not kept.all() else np.zeros(Jm.shape[1], bool)
+    out, it = [], iter(zip(np.sqrt(np.clip(np.diag(cov), 0.0, None)), unresolved))
     for m in moves:
-        out.append(float(next(it)) if m else None)
+        if not m:
+            out.append(None)
+            continue
+        sig, lost = next(it)
+        out.append(None if lost else float(sig))
     return out
 
 

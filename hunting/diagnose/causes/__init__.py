@@ -15,7 +15,8 @@ variant has, when some do not apply to it: :func:`hyper_keys`; ``derived_sigma(p
 giving the standard uncertainty of parameters computed from them, and ``refine_starts(hyper)``:
 other starting values of hyper-parameters the search holds fixed), ``UNITS`` (of the parameters), ``sentence(p,
 increments, model)`` (the finding in words), ``untestable(kin, model)`` (why a record cannot test
-it), ``EXCLUDES`` (causes it cannot be combined with), ``NOISE_FED`` (its regressor is made of
+it; with ``ONE_WAY_VALIDATION`` it takes ``validation=True`` for a record that only judges a fit made
+on another: :func:`untestable`), ``EXCLUDES`` (causes it cannot be combined with), ``NOISE_FED`` (its regressor is made of
 measured derivatives: judged also along a noise-free instrument trajectory), ``JUDGED_FIRST``
 (an own-evidence cause whose evidence reads only the measured records, judged before the other
 channels so that their re-simulations run on its extension), ``FRICTION_FORCE`` (a change of the

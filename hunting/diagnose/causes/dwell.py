@@ -342,13 +342,6 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         # 15 % off, are no longer named)
         out = _regained(out, tv, Fv, sv, np.concatenate([t, tv]), np.concatenate([F, Fv]), np.concatenate([s, sv]))
         loop = dwell_loop.verdict(loop, validate, model, out["p_value"], fit_meas=fit, rest_times=held)
-    if loop is None and can_sim:
-        held = rest_durations(fit, model, resolution)
-        if held.size:
-            # the time grid spans the rests whose length is known (the first one's is a lower
-            # bound, often the whole preamble: with it the grid's times ran long and the fit missed
-            # reporting28 d0586's 0.22 s growth, validation -15 %; with the three later rests, +85 %)
-            loop = dwell_loop.unprompted(fit, validate, model, t if t.size else held, _unasked(out))
     t_all, F_all, s_all = np.concatenate([t, tv]), np.concatenate([F, Fv]), np.concatenate([s, sv])
     level = level_verdict(t_all, F_all, s_all, np.concatenate([scale, scale_v]), model, sliding_speeds(kf, kv))
     if level is not None and "also" in level and out.get("fitted_on") == "loop":
@@ -357,6 +350,13 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         level = sliding_contradiction(level, model, kf, kv)
     if level is not None:
         return dict(out, otherwise=level)
+    if loop is None and can_sim:
+        held = rest_durations(fit, model, resolution)
+        if held.size:
+            # the time grid spans the rests whose length is known (the first one's is a lower
+            # bound, often the whole preamble: with it the grid's times ran long and the fit missed
+            # reporting28 d0586's 0.22 s growth, validation -15 %; with the three later rests, +85 %)
+            loop = dwell_loop.unprompted(fit, validate, model, t if t.size else held, _unasked(out))
     return out if loop is None else dict(out, otherwise=loop)
 
 

@@ -178,6 +178,14 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
     ``fit_meas`` (the fitting record) and ``rest_times`` (its rests) are given."""
     from ..resimulate import position_rms_error
     f0, f1 = loop["fit"]
+    if loop["model"].dwell is None:       # nothing fitted (no static friction to grow from, or no re-simulation)
+        v0 = position_rms_error(val_meas, model)
+        v0 = float(v0) if np.isfinite(v0) else 0.0
+        return dict(statistic=None, p_value=None, significant=False,
+                    evidence="no growth could be fitted on the fitting record's loop (no static friction in the model, "
+                             "or the loop does not re-simulate)",
+                    parameters={}, sigma={}, metric="re-simulated position RMS error [m], validation",
+                    nominal=v0, extended=v0, model=model)
     gain_f = 1.0 - f1 / f0 if np.isfinite(f0) and f0 > 0 and np.isfinite(f1) else -np.inf
     v0, v1 = position_rms_error(val_meas, model), position_rms_error(val_meas, loop["model"])
     gain_v = 1.0 - v1 / v0 if np.isfinite(v0) and v0 > 0 and np.isfinite(v1) else -np.inf
@@ -185,7 +193,7 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
     ok = gain_f >= LOOP_GAIN and gain_v >= LOOP_VALIDATION_GAIN
     if ok:
         asked = f"the rests suggest a growth (p = {p:.2g} < {GATE:g}) and" if p is not None else f"{prompt}, but"
-        words = (f"{asked} the loop re-simulated with it (fitted on "
+        words = (f"{asked} the loop re-simulated with a growth (fitted on "
                  f"the fitting record's position) follows both records better: position RMS error -{gain_f:.0%} "
                  f"fitting, -{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} needed)")
     elif gain_f < LOOP_GAIN:
