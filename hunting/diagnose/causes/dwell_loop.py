@@ -54,6 +54,7 @@ GAIN_RANGE = (0.05, 5.0)
 TIMES = 3            # the time's grid: geometric from half the shortest rest to twice the longest
 EVALS = 20           # Nelder-Mead evaluations after the grid
 SIGMA_STEP = 0.05    # half step in log gain and log time of the uncertainty's central differences
+START_STEP = 0.3     # the simplex's steps in log gain and log time of a fit from a start alone
 SCREEN = 0.5         # unprompted: the grid's best must cut the fitting record's error by this share of LOOP_GAIN
 
 
@@ -94,8 +95,11 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
         return model, np.inf
     x0 = min(points, key=cost)
     if np.isfinite(cost(x0)) and (floor is None or cost(x0) < floor):
+        # from a start alone, a simplex of fixed steps in log gain and log time (scipy's default,
+        # 5 % of |x0|, is tiny near log 1 = 0: a refit from the other record's values hardly moved)
+        simplex = None if grid else np.array(x0) + np.array([[0.0, 0.0], [START_STEP, 0.0], [0.0, START_STEP]])
         minimize(lambda x: min(cost(x), 1e300), np.array(x0), method="Nelder-Mead",
-                 options=dict(maxfev=EVALS, xatol=0.02, fatol=0.0))
+                 options=dict(maxfev=EVALS, xatol=0.02, fatol=0.0, initial_simplex=simplex))
     (lg, lt), err = min(cache.items(), key=lambda kv: kv[1])
     return _with(model, np.exp(lg), np.exp(lt)), err
 
