@@ -69,15 +69,11 @@ def rests(meas, model, resolution: float, level: np.ndarray | None = None
     ``level`` (n,) [N]: the sliding friction right after a break-away at each sample where the
     model's frictional memory makes it differ from Fs (:func:`level_after_break_away`); None:
     Fs."""
-    from ..behaviour import stick_phases
     dt = meas.dt
-    # a count, or the sensor's noise band where that is wider (noise would fake moves and rests)
-    resolution = max(resolution, 1e-15) + 4.0 * model.sensor_noise
-    phases = stick_phases(meas.q, dt, resolution, window=REST_WINDOW)
+    phases, resolution, ahead = _rest_phases(meas, model, resolution)
     u_at = np.concatenate([[meas.u[0]], 0.5 * (meas.u[1:] + meas.u[:-1])])
     F = model.cm * u_at + meas.force_ext() - model.offset - model.cogging_force(meas.q)
     tr, Fb, sd, rp = [], [], [], []
-    ahead = max(int(round(0.05 / dt)), 2)
     span = max(int(round(0.01 / dt)), 3)
     for a, b in phases:
         if a == 0 or b + ahead >= meas.n:
@@ -364,11 +360,19 @@ def rest_durations(meas, model, resolution: float) -> np.ndarray:
     """Durations (m,) [s] of the rests in ``meas`` that end in motion before the record does, its
     first rest included (the contact rested longer before the record began: a lower bound): the
     break-aways the loop's dwell growth acts on (:func:`hunting.diagnose.causes.dwell_loop.unprompted`)."""
+    phases, _, ahead = _rest_phases(meas, model, resolution)
+    return np.array([(b - a + 1) * meas.dt for a, b in phases if b + ahead < meas.n])
+
+
+def _rest_phases(meas, model, resolution: float) -> tuple[list, float, int]:
+    """(stick phases of ``meas`` (first, last) sample indices, the band [m] they stay within, the
+    samples [-] a rest must end before the record does): the rests :func:`rests` reads and
+    :func:`rest_durations` counts. The band: a count, or the sensor's noise band where that is
+    wider (noise would fake moves and rests)."""
     from ..behaviour import stick_phases
     band = max(resolution, 1e-15) + 4.0 * model.sensor_noise
     ahead = max(int(round(0.05 / meas.dt)), 2)
-    return np.array([(b - a + 1) * meas.dt for a, b in stick_phases(meas.q, meas.dt, band, window=REST_WINDOW)
-                     if b + ahead < meas.n])
+    return stick_phases(meas.q, meas.dt, band, window=REST_WINDOW), band, ahead
 
 
 def _unasked(out: dict) -> str:
