@@ -208,3 +208,38 @@ def _sensitivity(lib: Library, name: str, hyper: dict, key: str, theta: np.ndarr
         x = mod.design(kin, lib.model, h)[lib.Sf.idx] @ theta
         out.append(x + (sh(kin, lib.model, h)[lib.Sf.idx] if sh else 0.0))
     return (out[0] - out[1]) / (2 * np.log(1.01))
+
+
+def members_parameters(lib, ex, cov=None) -> list:
+    """Per member of an explanation: (name, hyper, theta block, final parameters, sigma,
+    increments, the model after it); the extensions are applied in member order, each cause's
+    parameters read from the model it extends (the final values: no two members change the same
+    field)."""
+    out = []
+    cur = lib.model
+    k = 0
+    for name, j in ex.members:
+        mod = CAUSES[name]
+        v = lib.variants[name][j]
+        kk = v.Xf.shape[1]
+        th = ex.theta[k:k + kk]
+        pars = mod.parameters(th, v.hyper, cur)
+        base = mod.parameters(np.zeros(kk), v.hyper, cur)
+        inc = {key: float(pars[key] - base[key]) for key in pars if key not in v.hyper}
+        sig = {}
+        for key in pars:
+            if key in v.hyper or cov is None:
+                sig[key] = None
+                continue
+            grad = np.zeros(kk)
+            for i in range(kk):
+                h = 1e-6 * max(1.0, abs(th[i]))
+                tp = th.copy()
+                tp[i] += h
+                grad[i] = (mod.parameters(tp, v.hyper, cur)[key] - pars[key]) / h
+            blk = cov[k:k + kk, k:k + kk]
+            sig[key] = float(np.sqrt(max(grad @ blk @ grad, 0.0)))
+        cur = mod.extend(cur, th, v.hyper)
+        out.append((name, v.hyper, th.copy(), pars, sig, inc, cur))
+        k += kk
+    return out

@@ -294,6 +294,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if force_names and _informative(kf) and _informative(kv):
         fc = _identified_force_channel(_library_builder(fit, validate, kf, kv, model, window, alpha, notes),
                                        force_names, model, max_causes, alpha, min_gain, alpha_reference, untested)
+        if not same and fc["causes"]:
+            from .spread import validation_values, widen
+            swapped = _library_builder(validate, fit, kv, kf, model, window, alpha, None)
+            fc = dict(fc, causes=widen(fc["causes"], validation_values(swapped, [c.name for c in fc["causes"]])))
         if not same and split is None:
             fc = _validation_only(fc, force_names, model, validate, kf, kv, sensor, window if window_given else None,
                                   (max_causes, alpha, min_gain, alpha_reference), untested, notes)
@@ -707,41 +711,6 @@ def _rms(r) -> float:
     return float(np.sqrt(np.mean(r ** 2)))
 
 
-def _members_parameters(lib, ex, cov=None) -> list:
-    """Per member of an explanation: (name, hyper, theta block, final parameters, sigma,
-    increments, the model after it); the extensions are applied in member order, each cause's
-    parameters read from the model it extends (the final values: no two members change the same
-    field)."""
-    out = []
-    cur = lib.model
-    k = 0
-    for name, j in ex.members:
-        mod = CAUSES[name]
-        v = lib.variants[name][j]
-        kk = v.Xf.shape[1]
-        th = ex.theta[k:k + kk]
-        pars = mod.parameters(th, v.hyper, cur)
-        base = mod.parameters(np.zeros(kk), v.hyper, cur)
-        inc = {key: float(pars[key] - base[key]) for key in pars if key not in v.hyper}
-        sig = {}
-        for key in pars:
-            if key in v.hyper or cov is None:
-                sig[key] = None
-                continue
-            grad = np.zeros(kk)
-            for i in range(kk):
-                h = 1e-6 * max(1.0, abs(th[i]))
-                tp = th.copy()
-                tp[i] += h
-                grad[i] = (mod.parameters(tp, v.hyper, cur)[key] - pars[key]) / h
-            blk = cov[k:k + kk, k:k + kk]
-            sig[key] = float(np.sqrt(max(grad @ blk @ grad, 0.0)))
-        cur = mod.extend(cur, th, v.hyper)
-        out.append((name, v.hyper, th.copy(), pars, sig, inc, cur))
-        k += kk
-    return out
-
-
 def _identified_force_channel(library, names, model, max_causes, alpha, min_gain, alpha_reference, untested) -> dict:
     """The force channel's result (:func:`_force_channel`) with every selected cause identified:
     a cause whose ``unidentified(parameters, sigma)`` hook gives a reason (its fitted parameters do
@@ -775,14 +744,14 @@ def _identified_force_channel(library, names, model, max_causes, alpha, min_gain
 def _force_channel(lib, model, sel, min_gain: float) -> dict:
     """Causes, extended model, residuals and alternatives from the force channel's selection."""
     from .force import compatible
-    from .refine import refine
+    from .refine import members_parameters, refine
     ex = sel["explanation"]
     mf, mv = lib.used_f, lib.used_v
     cov, hyper_sigma, idle = None, {}, []
     if ex.cols:
         ex, _, cov, hyper_sigma = refine(lib, ex)
         ex, cov, hyper_sigma, idle = _idle_after_refinement(lib, ex, cov, hyper_sigma, min_gain)
-    rows = _members_parameters(lib, ex, cov)
+    rows = members_parameters(lib, ex, cov)
     pred_v = lib.prediction(ex, "v")
     rv_ext = np.where(mv, lib.rv - pred_v, np.nan)
     causes = []
@@ -814,7 +783,7 @@ def _force_channel(lib, model, sel, min_gain: float) -> dict:
             alt = fits.get(alt_set) or lib.best_variants(alt_set)
             if not alt.physical:
                 continue
-            row = [r for r in _members_parameters(lib, alt) if r[0] == mate][0]
+            row = [r for r in members_parameters(lib, alt) if r[0] == mate][0]
             alternatives.append(dict(name=mate, kind="same family", replaces=c.name, parameters=row[3],
                                      bic_difference=float(alt.bic - ex.bic),
                                      gain=dict(metric="force residual RMS [N], validation, in place of " + c.name,
@@ -829,7 +798,7 @@ def _force_channel(lib, model, sel, min_gain: float) -> dict:
             continue
         rms1 = lib.validation_rms(alone)
         if alone.bic < empty.bic and rms1 < (1 - min_gain) * nominal_rms:
-            row = _members_parameters(lib, alone)[0]
+            row = members_parameters(lib, alone)[0]
             alternatives.append(dict(name=name, kind="alone", absorbed_by=sorted(chosen), parameters=row[3],
                                      bic_difference=float(alone.bic - ex.bic),
                                      gain=dict(metric="force residual RMS [N], validation, alone", nominal=nominal_rms,
