@@ -467,3 +467,77 @@ def test_dwell_reads_a_break_away_into_a_lagging_level(deficit):
     F_as_if_Fs = dwell.rests(meas, model, 1e-6)[1]
     assert F.size == 1 and abs(F[0] - 1.0) < 0.03
     assert 1.0 - F_as_if_Fs[0] > 0.05
+
+
+def _first_slip_friction(sliding: bool):
+    """The friction force (n,) [N] and speeds (n,) [m/s] of the first slip of a PD loop pushed out
+    of a long rest on a Stribeck contact (Fc 10, Fs 15 N, vs 10 mm/s) whose break-away grows by
+    5 N (Dwell sliding as given), from the re-simulation's u and v (m = cm = 1)."""
+    from hunting.diagnose.model import Dwell
+    from hunting.diagnose.resimulate import resimulate
+    m = NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0},
+                                "friction": {"law": "stribeck", "Fc": 10.0, "Fs": 15.0, "vs": 0.01, "beta": 2.0},
+                                "controller": {"type": "pid", "kp": 4e4, "kd": 400.0, "ki": 0.0}})
+    m = m.replace(dwell=Dwell(0.0, 5.0, 0.1, sliding))
+    dt = 1e-3
+    t = np.arange(0.0, 1.5, dt)
+    r = np.where(t < 0.5, 0.0, 0.004 * (t - 0.5))
+    sim = resimulate(Measurement(t=t, q=np.zeros_like(t), u=np.zeros_like(t), q_ref=r, name="push"), m,
+                     resolution=1e-9, substeps=50)
+    F = sim.u - np.gradient(sim.v, dt)
+    k = np.flatnonzero(~sim.stuck & (sim.v > 0))
+    k = k[(k > 0) & (k < t.size - 1)]
+    first = k[:int(np.argmax(np.diff(k) > 1)) or k.size]
+    return F[first], sim.v[first]
+
+
+@pytest.mark.parametrize("sliding", [False, True])
+def test_dwell_growth_acts_on_the_slip_only_in_the_seven_parameter_form(sliding):
+    """Kato's form raises the break-away alone: the slip after the rest follows the nominal
+    Stribeck curve (Fs 15 N). The seven-parameter form's slip starts from the grown break-away
+    force: its Stribeck curve has Fs 15 + 5 N. The friction the loop felt (u - m a), against
+    both curves evaluated independently: it follows its own within 1 N RMS (the finite
+    difference of v), the other's by more than 1.5 N."""
+    F, v = _first_slip_friction(sliding)
+    assert v.size >= 10
+
+    def rms(Fs):
+        return np.sqrt(np.mean((F - (10.0 + (Fs - 10.0) * np.exp(-(v / 0.01) ** 2))) ** 2))
+    own, other = (rms(20.0), rms(15.0)) if sliding else (rms(15.0), rms(20.0))
+    assert own < 1.0 < 1.5 < other
+
+
+def test_dwell_form_round_trips_through_the_model_file():
+    from hunting.errors import SystemDefinitionError
+    d = {"plant": {"mass": 1.0}, "friction": {"law": "stribeck", "Fc": 1.0, "Fs": 2.0, "vs": 0.01,
+                                              "dwell": {"level": 0.0, "gain": 0.5, "time": 0.2, "sliding": True}}}
+    m = NominalModel.from_dict(d)
+    assert m.dwell.sliding and NominalModel.from_dict(m.to_dict()).dwell == m.dwell
+    d["friction"]["dwell"]["sliding"] = "yes"
+    with pytest.raises(SystemDefinitionError, match="sliding"):
+        NominalModel.from_dict(d)
+    del d["friction"]["dwell"]["sliding"]
+    assert not NominalModel.from_dict(d).dwell.sliding
+    assert "sliding" not in NominalModel.from_dict(d).to_dict()["friction"]["dwell"]
+
+
+@pytest.mark.parametrize("sliding", [False, True])
+def test_dwell_growth_fitted_on_the_loop_keeps_the_form_the_model_declares(sliding):
+    """A nominal model that declares its dwell growth's form (the seven-parameter one, or Kato's)
+    has the loop's growth fitted, its uncertainty estimated and its break-away level refitted in
+    that form: the extension does not silently switch to the other."""
+    from hunting.diagnose.causes import dwell_loop
+    from hunting.diagnose.model import Dwell
+    m = NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0},
+                                "friction": {"law": "stribeck", "Fc": 10.0, "Fs": 15.0, "vs": 0.01, "beta": 2.0},
+                                "controller": {"type": "pid", "kp": 4e4, "kd": 400.0, "ki": 0.0}})
+    m = m.replace(dwell=Dwell(0.0, 5.0, 0.1, sliding))
+    dt = 1e-3
+    t = np.arange(0.0, 1.5, dt)
+    r = np.where(t < 0.5, 0.0, 0.004 * (t - 0.5))
+    meas = Measurement(t=t, q=np.zeros_like(t), u=np.zeros_like(t), q_ref=r, name="push")
+    ext, err = dwell_loop.fit(meas, m, np.array([0.5]), grid=False, start=(4.0, 0.1))
+    assert np.isfinite(err) and ext.dwell.sliding is sliding
+    assert dwell_loop._with(m, 1.0, 0.2).dwell.sliding is sliding
+    assert dwell_loop._with(m.replace(dwell=None), 1.0, 0.2).dwell.sliding is False
+    assert ("seven-parameter" in dwell_loop.form_words(ext.dwell)) is sliding

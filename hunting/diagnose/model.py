@@ -106,12 +106,16 @@ class Flexibility:
 @dataclass(frozen=True)
 class Dwell:
     """Break-away force growing with the time at rest t_r (static laws): Fs + level + gain (1 -
-    exp(-t_r / time)) in either direction [N, N, s] (Kato's dwell-time effect); sliding friction is
-    unchanged."""
+    exp(-t_r / time)) in either direction [N, N, s] (Kato's dwell-time effect). ``sliding`` says
+    what the slip after the rest feels: False, the nominal sliding friction (the break-away alone
+    grows); True, the seven-parameter model's form (Armstrong-Helouvry; thesis section 2.2): the
+    Stribeck curve of that slip has the grown break-away force as its static level Fs, until the
+    next stop."""
 
     level: float
     gain: float
     time: float
+    sliding: bool = False
 
     def __post_init__(self):
         check_finite("dwell level", self.level)
@@ -306,6 +310,8 @@ class NominalModel:
             fr["lag"] = self.lag
         if self.dwell is not None:
             fr["dwell"] = {"level": self.dwell.level, "gain": self.dwell.gain, "time": self.dwell.time}
+            if self.dwell.sliding:
+                fr["dwell"]["sliding"] = True
         plant = {"mass": self.mass, "motor_constant": self.cm, "offset": self.offset}
         if self.delay:
             plant["delay"] = self.delay
@@ -430,9 +436,12 @@ def _from_description(d: dict, where: str) -> NominalModel:
 def _dwell(d) -> Dwell | None:
     if d is None:
         return None
-    if not isinstance(d, dict) or set(d) != {"level", "gain", "time"}:
-        raise SystemDefinitionError(f"friction dwell = {d!r} must be {{'level': N, 'gain': N, 'time': s}}")
-    return Dwell(float(d["level"]), float(d["gain"]), float(d["time"]))
+    if not isinstance(d, dict) or not {"level", "gain", "time"} <= set(d) <= {"level", "gain", "time", "sliding"}:
+        raise SystemDefinitionError(f"friction dwell = {d!r} must be {{'level': N, 'gain': N, 'time': s}}, optionally "
+                                    "with 'sliding': true (the slip after a rest starts from the grown break-away force)")
+    if not isinstance(d.get("sliding", False), bool):
+        raise SystemDefinitionError(f"friction dwell sliding = {d['sliding']!r} must be true or false")
+    return Dwell(float(d["level"]), float(d["gain"]), float(d["time"]), bool(d.get("sliding", False)))
 
 
 def _flexibility(d) -> Flexibility | None:

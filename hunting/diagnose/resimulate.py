@@ -263,8 +263,11 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
     """Advance r.size samples from x = [q, v, z, stuck, I, D, x_prev, y_prev, qf_prev, rest time,
     d, w] (updated in place; d, w the flexible load's position and velocity relative to the
     motor). Returns the number of samples done (< r.size when the state stopped being finite). The break-away force after a rest of t_r is Fs + dwell level + gain (1 - exp(-t_r /
-    time)) (p[17:20]); the controller output is quantized to ctrl[9] when that is > 0."""
+    time)) (p[17:20]); with p[23] = 1 (the seven-parameter form) the slip that follows has it as
+    its Stribeck curve's Fs until the next stop. The controller output is quantized to ctrl[9]
+    when that is > 0."""
     h = dt / substeps
+    pl = p.copy()                      # the parameters of the current slip (its Fs, p[5] or p[10], may have grown)
     lugre = p[3] > 0.5
     hold = int(ctrl[8])
     u = u_init
@@ -308,9 +311,11 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                         break              # friction holds the mass
                     stuck = False
                     s = 1.0 if need > 0.0 else -1.0
+                    if p[23] > 0.5:        # the slip starts from the grown break-away force
+                        pl[5], pl[10] = p[5] + grow, p[10] + grow
                 else:
                     s = 1.0 if v > 0.0 else -1.0
-                qn, vn, zn, dn, wn = _rk4(q, v, z, d, w, s, fa, rem, p, cog, bases, False)
+                qn, vn, zn, dn, wn = _rk4(q, v, z, d, w, s, fa, rem, pl, cog, bases, False)
                 if s * vn > 0.0:
                     q, v, z, d, w = qn, vn, zn, dn, wn
                     break
@@ -319,8 +324,8 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                 # steps), then decide stick or slip for the rest of the substep
                 th = s * v / (s * v - s * vn) if s * v - s * vn > 0.0 else 1.0
                 for it in range(5):
-                    qa, va, za, da, wa = _rk4(q, v, z, d, w, s, fa, th * rem, p, cog, bases, False)
-                    acc = _rates(qa, va, za, da, wa, s, fa, p, cog, bases, False)[1]
+                    qa, va, za, da, wa = _rk4(q, v, z, d, w, s, fa, th * rem, pl, cog, bases, False)
+                    acc = _rates(qa, va, za, da, wa, s, fa, pl, cog, bases, False)[1]
                     th_new = th - va / (rem * acc) if acc != 0.0 else th
                     if it == 4 or not 0.0 < th_new <= 1.0 or abs(th_new - th) <= 1e-13:
                         break              # (qa, za, da, wa) is the state at th
@@ -352,7 +357,8 @@ def model_arrays(model: NominalModel):
         load = (fl.load_mass, fl.load_mass * wn ** 2, 2 * fl.damping * wn * fl.load_mass)
     p = np.array([model.mass, model.cm, model.offset, law, *model.curve.positive.encoded(),
                   *model.curve.negative.encoded(), model.sigma0 or 0.0, model.sigma1 or 0.0, model.lag,
-                  *((dw.level, dw.gain, dw.time) if dw is not None else (0.0, 0.0, 0.0)), *load])
+                  *((dw.level, dw.gain, dw.time) if dw is not None else (0.0, 0.0, 0.0)), *load,
+                  1.0 if dw is not None and dw.sliding else 0.0])
     blocks = [c.encoded() for c in model.cogging] or [np.zeros(3)]
     bases = np.cumsum([0] + [b.size for b in blocks[:-1]]).astype(np.int64)
     if not model.cogging:

@@ -472,7 +472,7 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
                     also=static_reading(e, model, speeds, f"{above}, read without the growth"))
     g, tau, sig, loo = _saturating_fit(t, e)
     base = model.dwell or Dwell(0.0, 0.0, tau)
-    ext = model.replace(dwell=Dwell(base.level, base.gain + g, tau))
+    ext = model.replace(dwell=Dwell(base.level, base.gain + g, tau, base.sliding))
     d = ext.dwell
     evidence = f"{above}; no growth with the rest resolved (rests of {t.min():.3g}-{t.max():.3g} s)"
     return dict(statistic=ratio, p_value=None, significant=True, rivals=("stribeck",),
@@ -574,7 +574,7 @@ def resolved_growth(t, e, s, model) -> dict | None:
         return None
     error = float(np.sqrt(np.mean(_left_out(t, e, lo) ** 2)))
     base = model.dwell or Dwell(0.0, 0.0, tau)
-    ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau))
+    ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau, base.sliding))
     d = ext.dwell
     return dict(evidence=(f"the excess grows with the rest (rests of {t.min():.3g}-{t.max():.3g} s): the growth fitted "
                           f"on the others beside a level per direction predicts each rest's to {growth:.3g} N RMS, "
@@ -731,7 +731,7 @@ def _growth_verdict(t, F, s, scale, tv, Fv, sv, scale_v, model) -> dict:
         return dict(out, reason=f"the break-away force falls with the rest in the fitting data (gain {th[1]:.3g} N): "
                                 "not a dwell effect")
     base = model.dwell or Dwell(0.0, 0.0, tau)
-    ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau))
+    ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau, base.sliding))
     ev0, ev1 = (e, _left_out(t, e, lo)) if pooled else (ev, excess(ext, tv, Fv, sv))
     d = ext.dwell
     return dict(out, pooled=pooled, parameters={"level": d.level, "gain": d.gain, "time": d.time},

@@ -58,20 +58,33 @@ START_STEP = 0.3     # the simplex's steps in log gain and log time of a fit fro
 SCREEN = 0.5         # unprompted: the grid's best must cut the fitting record's error by this share of LOOP_GAIN
 
 
-def _with(model, gain: float, time: float):
+def _with(model, gain: float, time: float, sliding: bool | None = None):
+    """``model`` with the dwell growth (gain [N], time [s]) in the form ``sliding``
+    (:class:`~hunting.diagnose.model.Dwell`; None: the model's own growth's form, Kato's where it
+    has none); its level the model's."""
     from ..model import Dwell
     level = model.dwell.level if model.dwell is not None else 0.0
-    return model.replace(dwell=Dwell(level, float(gain), float(time)))
+    if sliding is None:
+        sliding = model.dwell.sliding if model.dwell is not None else False
+    return model.replace(dwell=Dwell(level, float(gain), float(time), bool(sliding)))
+
+
+def form_words(dwell) -> str:
+    """The growth's form in words (:class:`~hunting.diagnose.model.Dwell` ``sliding``)."""
+    return ("the slip after each rest starting from the grown break-away force (the seven-parameter model's form)"
+            if dwell.sliding else "the break-away force alone growing, sliding friction unchanged")
 
 
 def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None = None,
-        grid: bool = True) -> tuple[object, float]:
+        grid: bool = True, sliding: bool | None = None) -> tuple[object, float]:
     """(model, error): ``model`` with the dwell growth (gain [N], time [s]; level the model's)
     that minimizes the re-simulated position RMS error [m] on ``meas``, and that error (inf where
     nothing re-simulates). ``rest_times`` (m,) [s]: the record's rests, which span the time grid;
     ``start``: (gain [N], time [s]) tried beside the grid (the break-away readings' fit);
     ``floor`` [m]: where the grid's best error is not below it, the grid's best is returned (no
-    Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone."""
+    Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone; ``sliding``: the growth's
+    form (:class:`~hunting.diagnose.model.Dwell`; None: the model's own, Kato's where it has
+    none)."""
     from scipy.optimize import minimize
 
     from ..resimulate import position_rms_error
@@ -84,7 +97,7 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
     def cost(x):                       # x = (log gain, log time)
         key = (round(float(x[0]), 9), round(float(x[1]), 9))
         if key not in cache:
-            e = position_rms_error(meas, _with(model, np.exp(x[0]), np.exp(x[1])))
+            e = position_rms_error(meas, _with(model, np.exp(x[0]), np.exp(x[1]), sliding))
             cache[key] = e if np.isfinite(e) else np.inf
         return cache[key]
     points = [(np.log(g), np.log(tau)) for g in Fs * np.geomspace(*GAIN_RANGE, GAINS)
@@ -101,7 +114,7 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
         minimize(lambda x: min(cost(x), 1e300), np.array(x0), method="Nelder-Mead",
                  options=dict(maxfev=EVALS, xatol=0.02, fatol=0.0, initial_simplex=simplex))
     (lg, lt), err = min(cache.items(), key=lambda kv: kv[1])
-    return _with(model, np.exp(lg), np.exp(lt)), err
+    return _with(model, np.exp(lg), np.exp(lt), sliding), err
 
 
 def sigma(ext, fit_meas, val_meas, model, rest_times) -> dict:
@@ -115,9 +128,9 @@ def sigma(ext, fit_meas, val_meas, model, rest_times) -> dict:
     from ..loop_sigma import coefficients_sigma, two_records
     d = ext.dwell
     x = np.log([d.gain, d.time])
-    within = coefficients_sigma(fit_meas, lambda v: _with(model, *np.exp(v)), x, np.full(2, SIGMA_STEP))
+    within = coefficients_sigma(fit_meas, lambda v: _with(model, *np.exp(v), d.sliding), x, np.full(2, SIGMA_STEP))
     within = [None, None] if within is None else within
-    ext_v, err_v = fit(val_meas, model, rest_times, start=(d.gain, d.time), grid=False)
+    ext_v, err_v = fit(val_meas, model, rest_times, start=(d.gain, d.time), grid=False, sliding=d.sliding)
     x_val = np.log([ext_v.dwell.gain, ext_v.dwell.time]) if np.isfinite(err_v) else [None, None]
     lg, lt = (two_records(w, xf, xv) for w, xf, xv in zip(within, x, x_val))
     return {"level": None, "gain": None if lg is None else float(d.gain * lg),
@@ -142,8 +155,9 @@ def refine(growth: dict, fit_meas, model, rest_times, val_meas=None) -> tuple[di
     if not (np.isfinite(f_loop) and f_loop < f0 and (f_loop < f_read or not np.isfinite(f_read))):
         return growth, loop
     d = ext.dwell
-    words = (f"the growth's gain and time fitted on the fitting record's re-simulated loop, which follows that record "
-             f"better than with the break-away readings' fit (position RMS error {f_loop:.3g} against {f_read:.3g} m)")
+    words = (f"the growth's gain and time fitted on the fitting record's re-simulated loop ({form_words(d)}), which "
+             f"follows that record better than with the break-away readings' fit (position RMS error {f_loop:.3g} "
+             f"against {f_read:.3g} m)")
     sig = (sigma(ext, fit_meas, val_meas, model, rest_times) if val_meas is not None
            else {"level": None, "gain": None, "time": None})
     return dict(growth, model=ext, parameters={"level": d.level, "gain": d.gain, "time": d.time},
@@ -197,8 +211,8 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
     ok = gain_f >= LOOP_GAIN and gain_v >= LOOP_VALIDATION_GAIN
     if ok:
         asked = f"the rests suggest a growth (p = {p:.2g} < {GATE:g}) and" if p is not None else f"{prompt}, but"
-        words = (f"{asked} the loop re-simulated with a growth (fitted on "
-                 f"the fitting record's position) follows both records better: position RMS error -{gain_f:.0%} "
+        words = (f"{asked} the loop re-simulated with a growth (fitted on the fitting record's position; "
+                 f"{form_words(d)}) follows both records better: position RMS error -{gain_f:.0%} "
                  f"fitting, -{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} needed)")
     elif gain_f < LOOP_GAIN:
         words = (f"fitted on the fitting record's loop the growth cuts its re-simulated position error by "
