@@ -1,0 +1,39 @@
+import math, sys
+import numpy as np
+import checks as C
+import generate as G
+
+def my_openloop(P, u, dt, n, res, tight=1.0):
+    mdl = G.build_model(P, res, dt)
+    mdl.atol = [a * tight for a in mdl.atol]; mdl.rtol *= tight
+    nd = int(math.floor(P['delay'] / dt + 1e-12)); r = P['delay'] - nd * dt
+    if r < 1e-12: r = 0.0
+    qs = np.zeros(n)
+    for k in range(n):
+        qs[k] = mdl.pos()
+        t, t1 = k * dt, (k + 1) * dt
+        ua = u[k - nd - 1] if k - nd - 1 >= 0 else 0.0
+        ub = u[k - nd] if k - nd >= 0 else 0.0
+        if r > 0:
+            mdl.advance(t, t + r, P['cm'] * ua - P['offset'])
+            mdl.advance(t + r, t1, P['cm'] * ub - P['offset'])
+        else:
+            mdl.advance(t, t1, P['cm'] * ub - P['offset'])
+    return qs
+
+def run(d, tmax):
+    m, tr, ex = C.load(d)
+    P = C.truth_spec(m, tr)
+    e = ex['fit']; dt = e['t'][1]; res = m['sensor']['resolution']
+    n = min(len(e['t']), int(tmax / dt))
+    a = my_openloop(P, e['u'], dt, n, res)
+    b = my_openloop(P, e['u'], dt, n, res, 1e-3)
+    c = C.ref_openloop(P, e['u'], dt, n)
+    qm = e['q'][:n]
+    print(d[-5:], tr['causes'] or 'clean', f'n={n} max|mine-tight|={np.max(np.abs(a-b))/res:.2e} res, '
+          f'max|mine-solve_ivp|={np.max(np.abs(a-c))/res:.2e} res, max|tight-solve_ivp|={np.max(np.abs(b-c))/res:.2e} res; '
+          f'stored-enc vs mine mism {np.sum(res*np.round(a/res)!=qm)}, vs solve_ivp {np.sum(res*np.round(c/res)!=qm)}')
+
+if __name__ == '__main__':
+    for d in sys.argv[2:]:
+        run(d, float(sys.argv[1]))
