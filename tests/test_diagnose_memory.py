@@ -469,14 +469,15 @@ def test_dwell_reads_a_break_away_into_a_lagging_level(deficit):
     assert 1.0 - F_as_if_Fs[0] > 0.05
 
 
-def _first_slip_friction(sliding: bool):
+def _first_slip_friction(sliding: bool, lag: float = 0.0):
     """The friction force (n,) [N] and speeds (n,) [m/s] of the first slip of a PD loop pushed out
     of a long rest on a Stribeck contact (Fc 10, Fs 15 N, vs 10 mm/s) whose break-away grows by
     5 N (Dwell sliding as given), from the re-simulation's u and v (m = cm = 1)."""
     from hunting.diagnose.model import Dwell
     from hunting.diagnose.resimulate import resimulate
     m = NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0},
-                                "friction": {"law": "stribeck", "Fc": 10.0, "Fs": 15.0, "vs": 0.01, "beta": 2.0},
+                                "friction": {"law": "stribeck", "Fc": 10.0, "Fs": 15.0, "vs": 0.01, "beta": 2.0,
+                                             "lag": lag},
                                 "controller": {"type": "pid", "kp": 4e4, "kd": 400.0, "ki": 0.0}})
     m = m.replace(dwell=Dwell(0.0, 5.0, 0.1, sliding))
     dt = 1e-3
@@ -524,8 +525,8 @@ def test_dwell_form_round_trips_through_the_model_file():
 @pytest.mark.parametrize("sliding", [False, True])
 def test_dwell_growth_fitted_on_the_loop_keeps_the_form_the_model_declares(sliding):
     """A nominal model that declares its dwell growth's form (the seven-parameter one, or Kato's)
-    has the loop's growth fitted, its uncertainty estimated and its break-away level refitted in
-    that form: the extension does not silently switch to the other."""
+    has the loop's growth fitted in that form (the fit and the models it builds keep it; a model
+    without a growth gets Kato's): the extension does not silently switch to the other."""
     from hunting.diagnose.causes import dwell_loop
     from hunting.diagnose.model import Dwell
     m = NominalModel.from_dict({"plant": {"mass": 1.0, "motor_constant": 1.0},
@@ -541,3 +542,25 @@ def test_dwell_growth_fitted_on_the_loop_keeps_the_form_the_model_declares(slidi
     assert dwell_loop._with(m, 1.0, 0.2).dwell.sliding is sliding
     assert dwell_loop._with(m.replace(dwell=None), 1.0, 0.2).dwell.sliding is False
     assert ("seven-parameter" in dwell_loop.form_words(ext.dwell)) is sliding
+
+
+@pytest.mark.parametrize("sliding", [False, True])
+def test_dwell_growth_starts_the_lagging_level_of_the_slip_in_the_seven_parameter_form(sliding):
+    """With frictional memory (lag 20 ms) the lagging level of the slip after a long rest starts
+    at the grown break-away force in the seven-parameter form (15 + 5 N) and at the relaxed static
+    level Fs (15 N) in Kato's: the first sample's friction, within 1 N."""
+    F, _ = _first_slip_friction(sliding, lag=0.02)
+    assert abs(F[0] - (20.0 if sliding else 15.0)) < 1.0
+
+
+def test_dwell_seven_parameter_form_needs_a_stribeck_curve():
+    """A Coulomb-viscous contact has no Stribeck velocity along which the grown force could decay
+    (its curve's Fs is Fc with a placeholder vs): the form is refused with the reason, not
+    re-simulated as a slip held at the grown force."""
+    from hunting.errors import SystemDefinitionError
+    d = {"plant": {"mass": 1.0}, "friction": {"law": "coulomb-viscous", "Fc": 1.0, "b": 0.1,
+                                              "dwell": {"level": 0.0, "gain": 0.5, "time": 0.2, "sliding": True}}}
+    with pytest.raises(SystemDefinitionError, match="needs a Stribeck curve"):
+        NominalModel.from_dict(d)
+    del d["friction"]["dwell"]["sliding"]
+    assert NominalModel.from_dict(d).dwell.sliding is False

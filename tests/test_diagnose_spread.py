@@ -28,6 +28,14 @@ def test_widen_takes_the_larger_of_the_stated_uncertainty_and_the_spread():
     assert out.parameters == c.parameters                           # the values stay the fitting record's
 
 
+def test_widen_leaves_a_parameter_the_fitting_record_did_not_estimate():
+    """A parameter the fitting record's variant holds (a Stribeck dip's Fc: the nominal value,
+    stated +-0) gets no uncertainty from its difference to the validation record's value."""
+    c = _cause({"Fc": 10.0, "Fs": 15.0}, {"Fc": 0.0, "Fs": 0.1})
+    out, = spread.widen([c], {"delay": {"Fc": 11.0, "Fs": 15.0}})
+    assert out.sigma == {"Fc": 0.0, "Fs": 0.1}
+
+
 def test_widen_keeps_a_cause_without_a_validation_value():
     c = _cause({"a": 1.0}, {"a": 0.01})
     assert spread.widen([c], {}) == [c]

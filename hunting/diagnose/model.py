@@ -110,7 +110,9 @@ class Dwell:
     what the slip after the rest feels: False, the nominal sliding friction (the break-away alone
     grows); True, the seven-parameter model's form (Armstrong-Helouvry; thesis section 2.2): the
     Stribeck curve of that slip has the grown break-away force as its static level Fs, until the
-    next stop."""
+    next stop (a curve with a Stribeck velocity, Fs > Fc, is needed: the grown force decays along
+    it; with frictional memory the lagging level starts there too). The seven-parameter form acts
+    in the re-simulated loop; the force channel's friction map is the nominal curve."""
 
     level: float
     gain: float
@@ -118,6 +120,8 @@ class Dwell:
     sliding: bool = False
 
     def __post_init__(self):
+        if not isinstance(self.sliding, bool):
+            raise SystemDefinitionError(f"dwell sliding = {self.sliding!r} must be True or False")
         check_finite("dwell level", self.level)
         check_finite_positive("dwell gain", self.gain, allow_zero=True)
         check_finite_positive("dwell time", self.time)
@@ -193,6 +197,14 @@ class NominalModel:
             raise SystemDefinitionError("friction lag applies to the static laws; LuGre has its own memory (sigma0, sigma1)")
         if self.dwell is not None and not isinstance(self.dwell, Dwell):
             raise SystemDefinitionError(f"dwell = {self.dwell!r} must be a Dwell")
+        if self.dwell is not None and self.dwell.sliding and not all(
+                c.Fs > c.Fc and not c.discontinuous for c in (self.curve.positive, self.curve.negative)):
+            raise SystemDefinitionError(
+                "friction dwell sliding = true needs a Stribeck curve in both directions (Fs > Fc, a finite beta): "
+                "the slip after a rest starts from the grown break-away force and decays along it; with law "
+                f"{self.law!r} and Fs {self.curve.positive.Fs:g}/{self.curve.negative.Fs:g} N, Fc "
+                f"{self.curve.positive.Fc:g}/{self.curve.negative.Fc:g} N there is none: give the Stribeck law's Fs and "
+                "vs, or leave sliding out (Kato's form)")
         check_finite_positive("mass", self.mass)
         if self.flexibility is not None and not self.flexibility.load_mass < self.mass:
             raise SystemDefinitionError(f"flexibility load_mass = {self.flexibility.load_mass!r} kg must be below the "

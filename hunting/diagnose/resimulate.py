@@ -313,6 +313,8 @@ def _loop(p, cog, bases, ctrl, r, fext, inj, noise, u_init, resolution, dt, subs
                     s = 1.0 if need > 0.0 else -1.0
                     if p[23] > 0.5:        # the slip starts from the grown break-away force
                         pl[5], pl[10] = p[5] + grow, p[10] + grow
+                        if p[16] > 0.0:    # ... and so does the lagging level
+                            z = (p[5] if s > 0.0 else p[10]) + grow
                 else:
                     s = 1.0 if v > 0.0 else -1.0
                 qn, vn, zn, dn, wn = _rk4(q, v, z, d, w, s, fa, rem, pl, cog, bases, False)

@@ -297,7 +297,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         if not same and fc["causes"]:
             from .spread import validation_values, widen
             swapped = _library_builder(validate, fit, kv, kf, model, window, alpha, None)
-            fc = dict(fc, causes=widen(fc["causes"], validation_values(swapped, [c.name for c in fc["causes"]])))
+            found = {c.name for c in fc["causes"]}
+            fc = dict(fc, causes=widen(fc["causes"], validation_values(swapped, [n for n in force_names if n in found])))
         if not same and split is None:
             fc = _validation_only(fc, force_names, model, validate, kf, kv, sensor, window if window_given else None,
                                   (max_causes, alpha, min_gain, alpha_reference), untested, notes)

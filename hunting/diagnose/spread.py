@@ -19,6 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .causes import CAUSES
 from .loop_sigma import two_records
 from .refine import members_parameters, refine
 
@@ -28,19 +29,37 @@ def validation_values(library, names) -> dict:
     record: ``library(names)`` builds the force channel's library with the records' roles
     swapped; the explanation is each cause's best grid variant given the others, refined as the
     fitting record's was. Empty where a cause cannot be tested with the roles swapped (e.g. the
-    validation record moves one way) or the fit is not physical: a value from another set of
-    causes would measure their difference, not the spread."""
-    lib = library(list(names))
-    if any(n not in lib.variants for n in names):
-        return {}
-    ex = lib.best_variants(tuple(n for n in lib.variants if n in names))
-    if not ex.physical:
-        return {}
-    if ex.cols:
-        ex, *_ = refine(lib, ex)
+    validation record moves one way), the fit is not physical or fails: a value from another set
+    of causes would measure their difference, not the spread. ``names`` in the fitting record's
+    explanation's order (the extensions are applied in it)."""
+    from ..errors import SystemDefinitionError
+    try:
+        lib = library(list(names))
+        if any(n not in lib.variants for n in names):
+            return {}
+        ex = lib.best_variants(tuple(names))
         if not ex.physical:
             return {}
-    return {row[0]: row[3] for row in members_parameters(lib, ex)}
+        cov, hyper_sigma = None, {}
+        if ex.cols:
+            ex, _, cov, hyper_sigma = refine(lib, ex)
+            if not ex.physical:
+                return {}
+        rows = members_parameters(lib, ex, cov)
+    except (SystemDefinitionError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return {}            # e.g. an extension the swapped fit makes unphysical: no second value
+    # only what the validation fit estimated (a stated uncertainty there, as the fitting record's
+    # causes get theirs: coefficients, refined hyper-parameters, parameters derived from them): a
+    # parameter its variant holds (a Stribeck dip's Fc, a tied vs_neg) is the nominal model's
+    # there, and its difference is no spread
+    out = {}
+    for name, _, _, pars, sig, _, _ in rows:
+        sig = dict(sig, **hyper_sigma.get(name, {}))
+        derived = getattr(CAUSES[name], "derived_sigma", None)
+        if derived is not None:
+            sig.update(derived(pars, sig))
+        out[name] = {k: v for k, v in pars.items() if sig.get(k)}
+    return out
 
 
 def widen(causes: list, values: dict) -> list:
@@ -57,7 +76,8 @@ def widen(causes: list, values: dict) -> list:
         sigma = {}
         for key, s in c.sigma.items():
             v = other.get(key)
-            ok = s is not None and v is not None and np.isfinite(v) and np.isfinite(c.parameters[key])
+            # s == 0: the fitting record's variant held the parameter (not estimated): nothing to widen
+            ok = bool(s) and v is not None and np.isfinite(v) and np.isfinite(c.parameters[key])
             sigma[key] = two_records(s, c.parameters[key], v) if ok else s
         out.append(replace(c, sigma=sigma))
     return out

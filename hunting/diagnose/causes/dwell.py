@@ -122,8 +122,11 @@ def rests(meas, model, resolution: float, level: np.ndarray | None = None
         x_end = n_fit - 1.0
         x_min = -float(min(k_end - n_fit + 1 - a, 3 * n_fit))     # within the rest: the line extrapolated
         drop = Fs_dir - slows
+        # in the seven-parameter form (Dwell.sliding) the slip starts from the grown force: no
+        # excess over the friction drives the departure, the ramp alone does
+        seven = model.dwell is not None and model.dwell.sliding
         for _ in range(DEPARTURE_PASSES):
-            D = departure_time(0.75 * resolution, model.mass, drop, toward)
+            D = departure_time(0.75 * resolution, model.mass, 0.0 if seven else drop, toward)
             x_b = min(max(x_end + 0.5 - D / dt, x_min), x_end)
             drop = max(s_k * float(icpt + slope * x_b), Fs_dir) - slows
         held = (k_end - n_fit + 1 + x_b - a + 0.5) * dt
