@@ -14,6 +14,7 @@ Schema (keys beyond these are errors, so typos are caught):
                   "sigma2": (alias of b), "Fc_neg": .., ... (direction-dependent values),
                   "lag": 0.01,                                   # [s] frictional memory
                   "dwell": {"level": 0.0, "gain": 5.0, "time": 1.0}},   # [N, N, s] break-away growth
+                  # (optional "sliding": true: the slip after a rest starts from the grown force)
      "controller": {"type": "pid", "form": "PDI" | "K", ...} | {"type": "pd-velocity-loop", ...},
      "sensor": {"resolution": 1e-6, "noise": 2e-7}}          # [m]; optional (see resimulate.py)
 """
@@ -42,7 +43,8 @@ errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(
                 "Fc" [N] (required), "Fs" [N], "vs" [m/s], "beta", "b" [N s/m];
                 "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg" for the negative direction;
                 "sigma0" [N/m], "sigma1" [N s/m] (lugre); "lag" [s];
-                "dwell": {"level": N, "gain": N, "time": s}
+                "dwell": {"level": N, "gain": N, "time": s, optional "sliding": true (the
+                seven-parameter form: the slip after a rest starts from the grown force)}
   "controller": {"type": "pid", "kp", "kd", "ki"} (or "form": "PDI" with "P", "D", "I", or
                 "form": "K" with "K"), optional "derivative_on": "error" | "measurement",
                 "tau_f" [s], "sample_time" [s], "saturation", "output_resolution";
