@@ -232,7 +232,13 @@ class RefPlant:
 
 def ref_openloop(P, u, dt, nmax):
     """Open-loop replay of a stored u with the independent reference plant."""
-    plant = RefPlant(P)
+    return replay_openloop(RefPlant(P), P, u, dt, nmax)
+
+
+def replay_openloop(plant, P, u, dt, nmax):
+    """Positions (nmax,) of ``plant`` (an object with pos() and advance(t0, t1, F)) driven
+    open-loop by the stored u through the actuator delay P['delay'] (a fractional delay splits
+    each sample interval in two)."""
     cm, off, delay = P['cm'], P['offset'], P['delay']
     nd = int(math.floor(delay / dt + 1e-12))
     r = delay - nd * dt

@@ -33,6 +33,16 @@ class Unstable(Exception):
     pass
 
 
+def clip_step(h, rem):
+    """(step, truncated): the proposed step h cut to the remaining interval rem, or to half of it
+    when it would leave a sliver (> rem / 2)."""
+    if h >= rem:
+        return rem, True
+    if h > 0.5 * rem:
+        return 0.5 * rem, True
+    return h, False
+
+
 def logu(rng, a, b):
     return float(math.exp(rng.uniform(math.log(a), math.log(b))))
 
@@ -141,14 +151,7 @@ class EventModel:
             else:
                 g0 = self.g(t, y)
             rem = t1 - t
-            h = self.h
-            trunc = False
-            if h >= rem:
-                h = rem
-                trunc = True
-            elif h > 0.5 * rem:
-                h = 0.5 * rem
-                trunc = True
+            h, trunc = clip_step(self.h, rem)
             if k1 is None:
                 k1 = self.rhs(y)
             while True:
@@ -430,14 +433,7 @@ class LuGreModel:
         y = self.y
         while t1 - t > EPS_T:
             rem = t1 - t
-            h = self.h
-            trunc = False
-            if h >= rem:
-                h = rem
-                trunc = True
-            elif h > 0.5 * rem:
-                h = 0.5 * rem
-                trunc = True
+            h, trunc = clip_step(self.h, rem)
             while True:
                 yn, en = self.ros_step(y, h)
                 self.nsteps += 1

@@ -1,4 +1,4 @@
-import math, sys
+import sys
 import numpy as np
 import checks as C
 import generate as G
@@ -6,20 +6,7 @@ import generate as G
 def my_openloop(P, u, dt, n, res, tight=1.0):
     mdl = G.build_model(P, res, dt)
     mdl.atol = [a * tight for a in mdl.atol]; mdl.rtol *= tight
-    nd = int(math.floor(P['delay'] / dt + 1e-12)); r = P['delay'] - nd * dt
-    if r < 1e-12: r = 0.0
-    qs = np.zeros(n)
-    for k in range(n):
-        qs[k] = mdl.pos()
-        t, t1 = k * dt, (k + 1) * dt
-        ua = u[k - nd - 1] if k - nd - 1 >= 0 else 0.0
-        ub = u[k - nd] if k - nd >= 0 else 0.0
-        if r > 0:
-            mdl.advance(t, t + r, P['cm'] * ua - P['offset'])
-            mdl.advance(t + r, t1, P['cm'] * ub - P['offset'])
-        else:
-            mdl.advance(t, t1, P['cm'] * ub - P['offset'])
-    return qs
+    return C.replay_openloop(mdl, P, u, dt, n)
 
 def run(d, tmax):
     m, tr, ex = C.load(d)
