@@ -68,9 +68,16 @@ class EventModel:
     """Piecewise-smooth mechanical model with stick (mode 0) and slip (mode +-1).
 
     Subclasses provide rhs(y), g(t, y) (event function, event when <= 0),
-    on_event(t, y), breakaway(t, y), g_stick(t, y), pos().
+    on_event(t, y), breakaway(t, y), g_stick(t, y).
     """
     static_stick = True
+
+    def pos(self):
+        """The encoder's side: the motor's position [m]."""
+        return self.y[0]
+
+    def vel(self):
+        return self.y[1]
 
     def _init_int(self, atol, rtol, dt):
         self.atol = atol
@@ -213,12 +220,6 @@ class RigidModel(EventModel):
         atol = [ATOL_Q * res, ATOL_V * min(self.vs, res / dt)]
         self._init_int(atol, RTOL, dt)
 
-    def pos(self):
-        return self.y[0]
-
-    def vel(self):
-        return self.y[1]
-
     def fapp(self, q):
         if self.cogA:
             return self.F - self.cogA * math.sin(self.cogk * q + self.cogphi)
@@ -291,12 +292,6 @@ class FlexModel(EventModel):
         atol = [ATOL_Q * res, ATOL_V * min(self.vs, res / dt), ATOL_Q * res,
                 ATOL_V * min(self.vs, res / dt)]
         self._init_int(atol, RTOL, dt)
-
-    def pos(self):
-        return self.y[0]
-
-    def vel(self):
-        return self.y[1]
 
     def fapp_y(self, y):
         return self.F - self.k * (y[0] - y[2]) - self.c * (y[1] - y[3])

@@ -243,3 +243,15 @@ def members_parameters(lib, ex, cov=None) -> list:
         out.append((name, v.hyper, th.copy(), pars, sig, inc, cur))
         k += kk
     return out
+
+
+def member_sigma(name: str, parameters: dict, sigma: dict, hyper_sigma: dict) -> dict:
+    """A member's standard uncertainties complete: ``sigma`` (its coefficients', from
+    :func:`members_parameters`) with its refined hyper-parameters' (``hyper_sigma``, refine's
+    {name: {key: sigma}}) and those of parameters computed from them (the cause's
+    ``derived_sigma``)."""
+    sig = dict(sigma, **hyper_sigma.get(name, {}))
+    derived = getattr(CAUSES[name], "derived_sigma", None)
+    if derived is not None:             # parameters computed from refined hyper-parameters
+        sig.update(derived(parameters, sig))
+    return sig

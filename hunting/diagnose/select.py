@@ -745,7 +745,7 @@ def _identified_force_channel(library, names, model, max_causes, alpha, min_gain
 def _force_channel(lib, model, sel, min_gain: float) -> dict:
     """Causes, extended model, residuals and alternatives from the force channel's selection."""
     from .force import compatible
-    from .refine import members_parameters, refine
+    from .refine import member_sigma, members_parameters, refine
     ex = sel["explanation"]
     mf, mv = lib.used_f, lib.used_v
     cov, hyper_sigma, idle = None, {}, []
@@ -757,10 +757,7 @@ def _force_channel(lib, model, sel, min_gain: float) -> dict:
     rv_ext = np.where(mv, lib.rv - pred_v, np.nan)
     causes = []
     for name, hyper, th, pars, sig, inc, _ in rows:
-        sig.update(hyper_sigma.get(name, {}))
-        derived = getattr(CAUSES[name], "derived_sigma", None)
-        if derived is not None:             # parameters computed from refined hyper-parameters
-            sig.update(derived(pars, sig))
+        sig = member_sigma(name, pars, sig, hyper_sigma)
         t = sel["tests"][name]
         causes.append(Cause(name, t["gain"], t["t"], t["p_value"], pars, sig,
                             dict(metric="force residual RMS [N], validation", nominal=t["rms_without"],

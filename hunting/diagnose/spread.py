@@ -19,9 +19,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from .causes import CAUSES
 from .loop_sigma import two_records
-from .refine import members_parameters, refine
+from .refine import member_sigma, members_parameters, refine
 
 
 def validation_values(library, names) -> dict:
@@ -54,10 +53,7 @@ def validation_values(library, names) -> dict:
     # there, and its difference is no spread
     out = {}
     for name, _, _, pars, sig, _, _ in rows:
-        sig = dict(sig, **hyper_sigma.get(name, {}))
-        derived = getattr(CAUSES[name], "derived_sigma", None)
-        if derived is not None:
-            sig.update(derived(pars, sig))
+        sig = member_sigma(name, pars, sig, hyper_sigma)
         out[name] = {k: v for k, v in pars.items() if sig.get(k)}
     return out
 
