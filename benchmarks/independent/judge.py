@@ -9,7 +9,8 @@ the notes, the seconds). Scoring: a clean record with any cause is a false alarm
 record is *named first* when the first cause is the true one or a name that stands for it
 (LuGre bristles: ``reversal`` or ``presliding``; a Stribeck change: ``stribeck`` or ``level``;
 a Coulomb-level asymmetry, a constant force while sliding: ``asymmetry`` or ``offset``, as in
-``benchmarks/blind/draw.py``), *found* when it is anywhere in the list."""
+``benchmarks/blind/draw.py``; a dwell growth: ``dwell`` or, in the seven-parameter form,
+``dwell_peak``, as in ``benchmarks/blind/report.py``), *found* when it is anywhere in the list."""
 from __future__ import annotations
 
 import argparse
@@ -19,7 +20,7 @@ import traceback
 from collections import defaultdict
 from pathlib import Path
 
-ALSO = {"reversal": {"presliding"}, "stribeck": {"level"}}
+ALSO = {"reversal": {"presliding"}, "stribeck": {"level"}, "dwell": {"dwell_peak"}}
 
 
 def accepted(truth: dict) -> set:

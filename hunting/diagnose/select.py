@@ -73,7 +73,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "prewhitened, autocorrelation-consistent standard error, Student's t with the validation data's filter windows less one as degrees of freedom, p < {alpha:g}; with a moving reference its prediction "
         "along the reference too, p < {alpha_reference:g}, and, with a controller in the model, that prediction's shape, alone and with "
         "the other noise-fed causes', explains at least {reference_gain:.1%} of it), dropping it grows the validation RMS by at least "
-        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), a change of the friction force's level or curve (offset, asymmetry, level, stribeck, viscous) moves the force by at least {relevance:.1%} of the mean Coulomb level (RMS on the validation record's sliding samples: smaller is no cause), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much and by {swap_share:.0%} of the nominal model's validation residual, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by both, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
+        "{min_gain:.0%} and by more than 1e-4 of the drive force's RMS (numerical precision), a change of the friction force's level or curve (offset, asymmetry, level, stribeck, viscous, dwell_peak) moves the force by at least {relevance:.1%} of the mean Coulomb level (RMS on the validation record's sliding samples: smaller is no cause), its own force change is at most 3 drive-force RMS (not cancelled by the others), and the set beats each of its subsets by as much (what fails is dropped and the rest refitted; when nothing holds, the best set without the failed causes is judged; a special case gives way to the general cause of its family, e.g. level to stribeck or viscous to asymmetry, when that explains the validation data better by as much and by {swap_share:.0%} of the nominal model's validation residual, and the general one to the special case otherwise; a searched set of as many causes that predicts the validation data better by both, or of fewer causes not worse by as much, each of its causes holding there, replaces it); other channels: their own statistic at "
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%} (saturation, whose evidence reads only the measured "
         "output, and quantization, whose evidence reads only the recorded signals, first: where one holds on the nominal "
         "model every other channel is judged on its extension, and where it fails there it is judged again last, on "
@@ -344,6 +344,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         for name in own_names:
             if name not in ticked:
                 tick(name)
+            mates = [c.name for c in fc["causes"] if c.family == getattr(CAUSES[name], "FAMILY", name)]
+            if mates:          # e.g. dwell after dwell_peak: the growth is in the extension in one form
+                untested.append(dict(name=name, reason=f"reported as {mates[0]}: the force channel found that cause "
+                                                       "of its family"))
+                continue
             cause, row, ext = _own_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim, res,
                                            lambda rivals: _found_family(rivals, result))
             if cause is not None:

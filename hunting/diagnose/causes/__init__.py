@@ -34,11 +34,11 @@ def with_curves(model: NominalModel, pos, neg=None) -> NominalModel:
     return model.replace(curve=DirectionalCurve(pos(model.curve.positive), neg(model.curve.negative)))
 
 
-from . import (asymmetry, cogging, delay, dwell, flexibility, lag, level, mass, offset, presliding,  # noqa: E402
+from . import (asymmetry, cogging, delay, dwell, dwell_peak, flexibility, lag, level, mass, offset, presliding,  # noqa: E402
                quantization, reversal, saturation, stribeck, viscous)
 
 CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, level, stribeck, viscous, mass, delay, flexibility, lag, reversal,
-                                presliding, dwell, saturation, quantization)}
+                                presliding, dwell, dwell_peak, saturation, quantization)}
 
 
 def hyper_keys(name: str, hyper: dict) -> tuple:
