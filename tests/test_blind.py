@@ -361,3 +361,18 @@ def test_peer_reports_nothing_on_a_record_that_does_not_move():
     out = peer.fit(kin, nominal)
     assert set(out["thresholds"]) == {f"{th:.6g}" for th in peer.THRESHOLDS}
     assert all(v["causes"] == [] for v in out["thresholds"].values())
+
+
+def test_a_dwell_found_in_the_seven_parameter_form_counts_as_the_dwell():
+    """A truth drawn with ``accept`` ["dwell"] is found by ``dwell_peak`` too (report.FORMS: the
+    same growth, found by the force channel in the seven-parameter form), its gain judged; other
+    causes' names are not widened."""
+    from benchmarks.blind import report
+    truth = {"causes": ["dwell"], "effects": [{"cause": "dwell", "variant": "", "gain": 0.5, "frac": 0.5,
+                                               "accept": ["dwell"], "params": {"gain": 2.0}}]}
+    rows = report.score({"d0000": truth}, {"d0000": {"causes": [
+        {"name": "dwell_peak", "parameters": {"gain": 2.1, "time": 0.1}, "sigma": {"gain": 0.1}}]}})
+    e = rows[0]["effects"][0]
+    assert e["found"] and e["first"] and rows[0]["extras"] == []
+    assert e["errors"] == {"gain": pytest.approx(0.05)}
+    assert report.accept_names({"cause": "stribeck", "accept": ["stribeck", "level"]}) == {"stribeck", "level"}

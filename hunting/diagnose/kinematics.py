@@ -43,7 +43,9 @@ class Kinematics:
     second differences of q; drive [N] : cm u (aligned for the zero-order hold) + f_ext; slide :
     bool, the mass slides (not stuck); resolution, noise [m] : the position sensor's step and
     noise (standard deviation before quantization); held [N] : cm u as sampled (each value held
-    over the interval after it), for the delayed drive."""
+    over the interval after it), for the delayed drive; q_measured [m] : the positions as
+    measured (q is smoothed over the window, which rounds a rest's corners off: rests are read
+    from these)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -60,6 +62,7 @@ class Kinematics:
     held: np.ndarray
     resolution: float = 0.0
     noise: float = 0.0
+    q_measured: np.ndarray | None = None
 
     @property
     def dt(self) -> float:
@@ -225,7 +228,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     change[1:] = slide[1:] != slide[:-1]
     moving &= edge & ~dilate(change, w // 2)
     return Kinematics(meas.t, q, v, a, force, float(cm), w * dt, moving, vf, a_inst, drive, slide,
-                      held, float(resolution), float(noise))
+                      held, float(resolution), float(noise), np.asarray(meas.q, float))
 
 
 def reference_kinematics(meas: Measurement, model, *, window: float | None = None) -> Kinematics | None:

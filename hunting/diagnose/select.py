@@ -43,7 +43,9 @@ The rule (stated in every report, :data:`RULE`):
   record's by ``LOOP_VALIDATION_GAIN``
   (:func:`~hunting.diagnose.causes.presliding.loop_evidence`).
   Presliding and reversal are one family (LuGre bristles): when the force channel found
-  reversal, presliding is not tested again.
+  reversal, presliding is not tested again. Nor is dwell after the force channel's dwell_peak (one
+  family, the dwell growth in the seven-parameter form), or presliding beside it (a LuGre
+  re-simulation holds no dwell growth).
 
 Causes are ranked by their score: how much the validation metric grows when each is dropped
 from the final extended model (force channel), or nominal / extended - 1 of the cause's own
@@ -332,6 +334,10 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         if ext.lag > 0:
             untested.append(dict(name=name, reason="the force channel found frictional memory (lag), which LuGre "
                                                    "bristles would replace"))
+            continue
+        if ext.dwell is not None and model.dwell is None:
+            untested.append(dict(name=name, reason="the force channel found a dwell growth (dwell_peak), which LuGre "
+                                                   "bristles' re-simulation would drop"))
             continue
         cause, row, ext = _stick_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim)
         if cause is not None:

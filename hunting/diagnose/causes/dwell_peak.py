@@ -29,6 +29,7 @@ FAMILY = "break-away"
 FRICTION_FORCE = True
 HYPERS = 1
 HYPER_KEYS = ("time",)
+EXCLUDES = ("reversal",)      # LuGre bristles' re-simulation holds no dwell growth
 UNITS = {"gain": "N", "time": "s"}
 TIMES = 12             # time constants searched
 MIN_RESTS = 3          # rests ending in a slip the record must have
@@ -46,7 +47,8 @@ def slip_rests(kin) -> np.ndarray:
     from ..behaviour import stick_phases
     n = kin.t.size
     band = max(kin.resolution, 1e-15) + 4.0 * kin.noise
-    phases = stick_phases(kin.q, kin.dt, band, window=REST_WINDOW)
+    q = kin.q if kin.q_measured is None else kin.q_measured       # the smoothed q rounds a rest's corners off
+    phases = stick_phases(q, kin.dt, band, window=REST_WINDOW)
     ends = np.array([b for _, b in phases], dtype=int)
     durations = np.array([np.inf if a == 0 else (b - a + 1) * kin.dt for a, b in phases])
     fast = np.flatnonzero(np.abs(kin.vf) > TURN_SPEED * np.max(np.abs(kin.vf)))
@@ -78,6 +80,10 @@ def untestable(kin, model) -> str | None:
     c = (model.curve.positive, model.curve.negative)
     if not all(x.Fs > x.Fc for x in c):
         return "the nominal curve has no Stribeck dip (Fs > Fc) for a grown static level to decay along"
+    if any(x.discontinuous for x in c):
+        return "the nominal curve is discontinuous (Fc at any speed): a grown static level has no shape to decay along"
+    if model.law == "lugre":
+        return "the nominal model has LuGre bristles, whose re-simulation holds no dwell growth"
     if model.dwell is not None:
         return "the nominal model has a dwell effect already"
     r = slip_rests(kin)
