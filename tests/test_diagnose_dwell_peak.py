@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from hunting.diagnose import Measurement, NominalModel, kinematics
-from hunting.diagnose.causes import dwell_peak
+from hunting.diagnose.causes import dwell, dwell_peak
 from hunting.diagnose.model import Dwell
 
 DT = 1e-3
@@ -70,7 +70,7 @@ def test_slip_rests_reads_each_slip_from_the_rest_before_it():
     m, kin, stuck = _record(5.0)
     r = dwell_peak.slip_rests(kin)
     edges = np.flatnonzero(np.diff(np.concatenate([[0], stuck.astype(np.int8), [0]])))
-    rests = [(a, b) for a, b in zip(edges[::2], edges[1::2]) if (b - a) * DT >= 2 * dwell_peak.REST_WINDOW]
+    rests = [(a, b) for a, b in zip(edges[::2], edges[1::2]) if (b - a) * DT >= 2 * dwell.REST_WINDOW]
     assert len(rests) == 5 and rests[0][0] == 0
     assert np.isinf(r[rests[0][1] + 30])
     for a, b in rests[1:-1]:

@@ -372,10 +372,23 @@ def _rest_phases(meas, model, resolution: float) -> tuple[list, float, int]:
     samples [-] a rest must end before the record does): the rests :func:`rests` reads and
     :func:`rest_durations` counts. The band: a count, or the sensor's noise band where that is
     wider (noise would fake moves and rests)."""
-    from ..behaviour import stick_phases
-    band = max(resolution, 1e-15) + 4.0 * model.sensor_noise
+    band = rest_band(resolution, model.sensor_noise)
     ahead = max(int(round(0.05 / meas.dt)), 2)
-    return stick_phases(meas.q, meas.dt, band, window=REST_WINDOW), band, ahead
+    return rest_phases(meas.q, meas.dt, band), band, ahead
+
+
+def rest_band(resolution: float, noise: float) -> float:
+    """The band [m] a rest's positions stay within: a count of ``resolution``, widened by four
+    times the sensor's ``noise`` (noise would fake moves and rests)."""
+    return max(resolution, 1e-15) + 4.0 * noise
+
+
+def rest_phases(q: np.ndarray, dt: float, band: float) -> list:
+    """The rests of measured positions q (n,) [m] at interval dt [s]: (first, last) sample indices
+    of the stick phases within two ``band``s for at least REST_WINDOW
+    (:func:`~hunting.diagnose.behaviour.stick_phases`)."""
+    from ..behaviour import stick_phases
+    return stick_phases(q, dt, band, window=REST_WINDOW)
 
 
 def _unasked(out: dict) -> str:

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..model import Dwell
 from ._words import _q
-from .dwell import REST_WINDOW      # [s] a rest: the position within two counts for this long
+from .dwell import rest_band, rest_phases
 
 NAME = "dwell_peak"
 DESCRIPTION = "dwell in the seven-parameter form: the Stribeck peak of each slip grows with the rest before it"
@@ -37,18 +37,17 @@ MIN_RESTS = 3          # rests ending in a slip the record must have
 
 def slip_rests(kin) -> np.ndarray:
     """The duration [s] (n,) of the rest that began each sample's slip: the last rest (the
-    position within two counts of the sensor's step or noise band for REST_WINDOW) that ended
+    position within two counts of the sensor's step or noise band for dwell's REST_WINDOW,
+    :func:`~hunting.diagnose.causes.dwell.rest_phases`) that ended
     before the sample with no turnaround since; 0 after a turnaround without a rest (the
     velocity, where above TURN_SPEED of its largest value, changes sign with no rest between), inf
     in a slip out of a rest at the record's start, 0 before the first event, NaN in the rests."""
     hit = _CACHE.get(id(kin))
     if hit is not None and hit[0] is kin:
         return hit[1]
-    from ..behaviour import stick_phases
     n = kin.t.size
-    band = max(kin.resolution, 1e-15) + 4.0 * kin.noise
     q = kin.q if kin.q_measured is None else kin.q_measured       # the smoothed q rounds a rest's corners off
-    phases = stick_phases(q, kin.dt, band, window=REST_WINDOW)
+    phases = rest_phases(q, kin.dt, rest_band(kin.resolution, kin.noise))
     ends = np.array([b for _, b in phases], dtype=int)
     durations = np.array([np.inf if a == 0 else (b - a + 1) * kin.dt for a, b in phases])
     fast = np.flatnonzero(np.abs(kin.vf) > TURN_SPEED * np.max(np.abs(kin.vf)))
@@ -93,20 +92,27 @@ def untestable(kin, model) -> str | None:
     return None
 
 
-def hypers(kin, model) -> list:
+def _rest_span(kin) -> tuple[float, float] | None:
+    """(shortest, longest) [s] of the record's rests that end in a slip (the shortest at least two
+    samples); None without one."""
     r = slip_rests(kin)
     d = r[np.isfinite(r) & (r > 0)]
     if d.size == 0:
+        return None
+    lo = max(float(np.min(d)), 2 * kin.dt)
+    return lo, max(float(np.max(d)), lo)
+
+
+def hypers(kin, model) -> list:
+    span = _rest_span(kin)
+    if span is None:
         return []
-    lo, hi = max(float(np.min(d)), 2 * kin.dt), float(np.max(d))
-    return [{"time": float(x)} for x in np.geomspace(lo / 3.0, 3.0 * max(hi, lo), TIMES)]
+    return [{"time": float(x)} for x in np.geomspace(span[0] / 3.0, 3.0 * span[1], TIMES)]
 
 
 def hyper_bounds(kin, model) -> dict:
-    r = slip_rests(kin)
-    d = r[np.isfinite(r) & (r > 0)]
-    lo, hi = (max(float(np.min(d)), 2 * kin.dt), float(np.max(d))) if d.size else (kin.dt, 1.0)
-    return {"time": (lo / 10.0, 10.0 * max(hi, lo))}
+    lo, hi = _rest_span(kin) or (kin.dt, 1.0)
+    return {"time": (lo / 10.0, 10.0 * hi)}
 
 
 def design(kin, model, hyper):
