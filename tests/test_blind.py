@@ -376,3 +376,21 @@ def test_a_dwell_found_in_the_seven_parameter_form_counts_as_the_dwell():
     assert e["found"] and e["first"] and rows[0]["extras"] == []
     assert e["errors"] == {"gain": pytest.approx(0.05)}
     assert report.accept_names({"cause": "stribeck", "accept": ["stribeck", "level"]}) == {"stribeck", "level"}
+
+
+def test_levels_scaled_apart_count_as_an_asymmetry_with_a_coulomb_part_only():
+    """``level_asymmetry`` (the two directions' levels scaled apart) names a drawn asymmetry whose
+    draw accepted a constant force (a Coulomb-level part), with Fc_pos and Fc_neg judged; a viscous
+    asymmetry, an offset and a level are not widened."""
+    from benchmarks.blind import report
+    truth = {"causes": ["asymmetry"], "effects": [{"cause": "asymmetry", "variant": "coulomb", "gain": 0.5, "frac": 0.5,
+                                                   "accept": ["asymmetry", "offset"],
+                                                   "params": {"Fc_pos": 1.2, "Fc_neg": 0.8, "offset": 0.2}}]}
+    rows = report.score({"d0000": truth}, {"d0000": {"causes": [
+        {"name": "level_asymmetry", "parameters": {"Fc_pos": 1.23, "Fc_neg": 0.8}, "sigma": {}}]}})
+    e = rows[0]["effects"][0]
+    assert e["found"] and e["first"] and rows[0]["extras"] == []
+    assert e["errors"] == {"Fc_pos": pytest.approx(0.025), "Fc_neg": pytest.approx(0.0)}
+    assert report.accept_names({"cause": "asymmetry", "accept": ["asymmetry"]}) == {"asymmetry"}
+    assert report.accept_names({"cause": "offset", "accept": ["offset"]}) == {"offset"}
+    assert report.accept_names({"cause": "level", "accept": ["level", "stribeck"]}) == {"level", "stribeck"}

@@ -1047,7 +1047,7 @@ def test_relevance_floor_is_sized_on_the_coulomb_level_for_friction_force_causes
                                                                           "vs": 0.01, "b": 1.0, "Fc_neg": 2.0,
                                                                           "Fs_neg": 3.0, "vs_neg": 0.01, "b_neg": 1.0}})
     friction = {n for n, m in CAUSES.items() if getattr(m, "FRICTION_FORCE", False)}
-    assert friction == {"offset", "asymmetry", "level", "stribeck", "viscous", "dwell_peak"}
+    assert friction == {"offset", "asymmetry", "level", "level_asymmetry", "stribeck", "viscous", "dwell_peak"}
     for name in CAUSES:
         expected = RELEVANCE * 3.0 if name in friction else 0.0
         assert relevance_floor(model, name) == pytest.approx(expected)

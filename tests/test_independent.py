@@ -1,8 +1,9 @@
 """The diagnosis on records of the independent generator (benchmarks/independent/: written from
 a one-page specification by an engineer who saw neither hunting's code nor the blind benchmark's
 generator). A few records of its seed-1 set, drawn here: clean ones get nothing, and one effect
-each of five causes is named first (reversal as LuGre bristles: ``reversal`` or ``presliding``; its
-dwell, in the seven-parameter form, as ``dwell_peak`` (or ``dwell``), its gain within 10 %).
+each of six causes is named first (reversal as LuGre bristles: ``reversal`` or ``presliding``; its
+dwell, in the seven-parameter form, as ``dwell_peak`` (or ``dwell``), its gain within 10 %; its
+asymmetry, one direction's level scaled, as ``level_asymmetry``).
 The whole set's rates are in docs/diagnosis.md."""
 import json
 import subprocess
@@ -15,7 +16,8 @@ from hunting.diagnose import NominalModel, diagnose, load
 
 ROOT = Path(__file__).resolve().parents[1]
 CLEAN = (4, 5, 7, 10)
-EFFECTS = {45: ("mass",), 49: ("offset",), 53: ("reversal", "presliding"), 44: ("delay",), 67: ("dwell", "dwell_peak")}
+EFFECTS = {45: ("mass",), 49: ("offset",), 53: ("reversal", "presliding"), 44: ("delay",), 67: ("dwell", "dwell_peak"),
+           66: ("asymmetry", "level_asymmetry")}
 
 
 @pytest.fixture(scope="module")
@@ -62,3 +64,14 @@ def test_the_seven_parameter_dwell_is_found_by_the_force_channel_and_reported_on
     assert c.parameters["gain"] == pytest.approx(truth["params"]["dFs"], rel=0.1)
     assert [u["reason"] for u in dg.as_dict()["untested"] if u["name"] == "dwell"] == [
         "reported as dwell_peak: the force channel found that cause of its family"]
+
+
+def test_one_direction_level_scaled_is_named_as_such(records):
+    """d0066: the negative direction's Fc and Fs scaled by 0.63 (the generator's Coulomb asymmetry;
+    read as a level and a constant force before ``level_asymmetry``): named alone, both directions'
+    Coulomb levels within 1 % of the truth."""
+    truth, dg = _diagnosis(records, 66)
+    assert [c.name for c in dg.causes] == ["level_asymmetry"]
+    p = dg.causes[0].parameters
+    assert p["Fc_neg"] == pytest.approx(truth["params"]["Fc_neg"], rel=0.01)
+    assert p["Fc_pos"] == pytest.approx(truth["params"]["Fc_pos"], rel=0.01)

@@ -40,6 +40,7 @@ PRIMARY = {"offset": ("offset",), "asymmetry": ("b_pos", "b_neg", "Fc_pos", "Fc_
            "cogging": ("pitch", "amplitude_1"), "presliding": ("sigma0",),
            "stribeck": ("Fs",), "level": ("Fc", "Fs"), "viscous": ("b",), "mass": ("mass",), "delay": ("delay",),
            "flexibility": ("load_mass", "frequency"), "lag": ("lag",), "reversal": ("sigma0",), "dwell": ("gain",), "dwell_peak": ("gain",),
+           "level_asymmetry": ("Fc_pos", "Fc_neg"),
            "saturation": ("saturation",), "quantization": ("output_resolution",)}
 # pairs that cannot coexist in one plant
 # (a level change and a Stribeck-shape change both rescale the curve's levels: one plant holds one)

@@ -53,12 +53,17 @@ def reported(result: dict) -> list:
 # diagnosis learnt to name in a second form after the sets were drawn: a dwell growth found by
 # the force channel in the seven-parameter form (``dwell_peak``, of dwell's family) is a dwell
 FORMS = {"dwell": ("dwell_peak",)}
+# ... and for the variants whose draw accepted a constant force (``offset``: an asymmetry with a
+# Coulomb-level part): the levels of the two directions scaled apart (``level_asymmetry``, whose
+# Fc_pos and Fc_neg are judged against the truth's) name that asymmetry too
+COULOMB_FORMS = {"asymmetry": ("level_asymmetry",)}
 
 
 def accept_names(effect: dict) -> set:
     """The reported names that count as finding a truth's ``effect``: its draw's ``accept``
-    and the cause's FORMS."""
-    return set(effect["accept"]) | set(FORMS.get(effect["cause"], ()))
+    and the cause's FORMS (COULOMB_FORMS where the draw accepted ``offset``)."""
+    extra = COULOMB_FORMS.get(effect["cause"], ()) if "offset" in effect["accept"] else ()
+    return set(effect["accept"]) | set(FORMS.get(effect["cause"], ())) | set(extra)
 
 
 def score(truths: dict, results: dict) -> dict:

@@ -9,7 +9,9 @@ the notes, the seconds). Scoring: a clean record with any cause is a false alarm
 record is *named first* when the first cause is the true one or a name that stands for it
 (LuGre bristles: ``reversal`` or ``presliding``; a Stribeck change: ``stribeck`` or ``level``;
 a Coulomb-level asymmetry, a constant force while sliding: ``asymmetry`` or ``offset``, as in
-``benchmarks/blind/draw.py``; a dwell growth: ``dwell`` or, in the seven-parameter form,
+``benchmarks/blind/draw.py``, and an asymmetry with a Coulomb-level part (variants ``coulomb`` and
+``both``, one direction's Fc and Fs scaled): ``level_asymmetry`` too, as in
+``benchmarks/blind/report.py``; a dwell growth: ``dwell`` or, in the seven-parameter form,
 ``dwell_peak``, as in ``benchmarks/blind/report.py``), *found* when it is anywhere in the list."""
 from __future__ import annotations
 
@@ -27,8 +29,11 @@ def accepted(truth: dict) -> set:
     """The names that count as finding the record's (single) effect."""
     cause = truth["causes"][0]
     names = {cause} | ALSO.get(cause, set())
-    if cause == "asymmetry" and truth.get("params", {}).get("variant") == "coulomb":
+    variant = truth.get("params", {}).get("variant")
+    if cause == "asymmetry" and variant == "coulomb":
         names.add("offset")
+    if cause == "asymmetry" and variant in ("coulomb", "both"):
+        names.add("level_asymmetry")
     return names
 
 

@@ -737,15 +737,20 @@ def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: floa
     model's validation residual ``rms0``): BIC on the fitting data favours the special case by its
     fewer parameters, and the validation data decide whether the general one's extra freedom is
     real (a Stribeck dip change otherwise came out as a level change plus a viscous one). None
-    otherwise."""
+    otherwise. Of several general causes (a level change is a special case of a Stribeck change
+    and of levels scaled apart per direction) the one that explains the validation data best."""
     for name in current.names:
+        best = None
         for general, mod in CAUSES.items():
             if name not in getattr(mod, "NESTS", ()) or general in dropped or general not in lib.variants:
                 continue
             alt, rms = _in_place(lib, fits, current, name, general)
-            if alt is not None and better(rms, rms_full, rms0, min_gain):
-                return name, alt, (f"{general}, of which it is a special case, explains the validation data "
-                                   f"{_better_words(min_gain)} ({rms:.4g} against {rms_full:.4g} N RMS)")
+            if alt is not None and better(rms, rms_full, rms0, min_gain) and (best is None or rms < best[2]):
+                best = (general, alt, rms)
+        if best is not None:
+            general, alt, rms = best
+            return name, alt, (f"{general}, of which it is a special case, explains the validation data "
+                               f"{_better_words(min_gain)} ({rms:.4g} against {rms_full:.4g} N RMS)")
     return None
 
 

@@ -34,10 +34,10 @@ def with_curves(model: NominalModel, pos, neg=None) -> NominalModel:
     return model.replace(curve=DirectionalCurve(pos(model.curve.positive), neg(model.curve.negative)))
 
 
-from . import (asymmetry, cogging, delay, dwell, dwell_peak, flexibility, lag, level, mass, offset, presliding,  # noqa: E402
-               quantization, reversal, saturation, stribeck, viscous)
+from . import (asymmetry, cogging, delay, dwell, dwell_peak, flexibility, lag, level, level_asymmetry, mass, offset,  # noqa: E402
+               presliding, quantization, reversal, saturation, stribeck, viscous)
 
-CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, level, stribeck, viscous, mass, delay, flexibility, lag, reversal,
+CAUSES = {m.NAME: m for m in (offset, asymmetry, cogging, level, level_asymmetry, stribeck, viscous, mass, delay, flexibility, lag, reversal,
                                 presliding, dwell, dwell_peak, saturation, quantization)}
 
 

@@ -1,6 +1,7 @@
 """Direction-dependent viscous friction: b+ for positive and b- for negative velocity, each free
-(a Coulomb-level difference is a constant force while moving: the ``offset`` cause; equal changes
-are the ``viscous`` cause, the special case b+ - b- unchanged)."""
+(a Coulomb-level difference is a constant force while moving: the ``offset`` cause, or each
+direction's whole Stribeck level scaled by its own factor: ``level_asymmetry``; equal changes are
+the ``viscous`` cause, the special case b+ - b- unchanged)."""
 from dataclasses import replace
 
 import numpy as np

@@ -15,8 +15,9 @@ The change against the nominal force while sliding is (k - 1) g(|v|) sign(v), g 
 Stribeck level of each direction: one coefficient, no hyper-parameter. It is the special case of
 the ``stribeck`` cause's change at the nominal vs (for beta = 2), of one family with it, and
 excludes it: the specific one wins by BIC when the data show no change of shape, the other is then
-listed as an alternative. A level that differs between the directions is ``asymmetry`` /
-``offset``."""
+listed as an alternative. A level that differs between the directions is ``level_asymmetry``
+(each direction's level scaled by its own factor, of which this cause is the special case) or a
+constant force, ``offset``."""
 from dataclasses import replace
 
 import numpy as np

@@ -101,7 +101,7 @@ def rest_force(kin, model) -> np.ndarray:
     loop of the tests, whose bristles carried a steady 18 N), and before the position leaves its
     count the mass already accelerates. Shorter sticks are turnarounds the position reads as a
     stick, which the bristles pass through integrated (their drive is mostly inertia)."""
-    from ..behaviour import stick_phases
+    from .dwell import rest_band, rest_phases
     hit = _REST_CACHE.get(id(kin))
     if hit is not None and hit[0] is kin and hit[1] is model:
         return hit[2]
@@ -111,8 +111,7 @@ def rest_force(kin, model) -> np.ndarray:
     # rests read as dwell's are (two counts, or the sensor's noise band): the samples' own stick
     # label splits a rest wherever noise moves the position by a count (463 pieces of at most
     # 13 ms on reporting8 d0477 at 5 kHz, none long enough to count)
-    band = max(kin.resolution, 1e-15) + 4.0 * kin.noise
-    for a, b in stick_phases(kin.q, kin.dt, band, window=REST):     # the rest [a, b]
+    for a, b in rest_phases(kin.q_measured, kin.dt, rest_band(kin.resolution, kin.noise)):     # the rest [a, b]
         lo = a + (b - a) // 2
         out[a:b + 1] = float(np.median(F[lo:max(b + 1 - guard, lo + 1)]))
     out.setflags(write=False)
