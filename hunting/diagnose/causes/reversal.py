@@ -89,12 +89,12 @@ def design(kin, model, hyper):
     return kin.sliding(change)[:, None]
 
 
-REST = 0.015        # [s] a stick this long is a rest whose force the bristles carry (dwell's REST_WINDOW)
 REST_GUARD = 0.005  # [s] the end of a rest left out of its force: the motion that ends it has begun
 
 
 def rest_force(kin, model) -> np.ndarray:
-    """The force [N] (n,) friction carries in each rest of at least REST (NaN elsewhere): the
+    """The force [N] (n,) friction carries in each rest (NaN elsewhere; the dwell cause's rests,
+    :func:`~hunting.diagnose.causes.dwell.rest_phases`, at least its REST_WINDOW long): the
     median of the drive less the offset and the cogging force (at rest a = 0) over the rest's
     second half up to REST_GUARD before its end. The drive of a digital loop at rest jumps by
     the controller's stiffness times a count from sample to sample (7 N on the synthetic LuGre
@@ -108,9 +108,11 @@ def rest_force(kin, model) -> np.ndarray:
     out = np.full(kin.t.size, np.nan)
     F = kin.delayed_drive(model.delay) - model.offset - model.cogging_force(kin.q)
     guard = int(round(REST_GUARD / kin.dt))
-    # rests read as dwell's are (two counts, or the sensor's noise band): the samples' own stick
-    # label splits a rest wherever noise moves the position by a count (463 pieces of at most
-    # 13 ms on reporting8 d0477 at 5 kHz, none long enough to count)
+    # rests read as dwell's are (two counts, or the sensor's noise band, on the measured positions):
+    # the samples' own stick label splits a rest wherever noise moves the position by a count (463
+    # pieces of at most 13 ms on reporting8 d0477 at 5 kHz, none long enough to count), and the
+    # smoothed positions round a rest's corners off (reporting29 d0421: sigma0 1.19 -> 1.00 times
+    # the truth read from the measured ones)
     for a, b in rest_phases(kin.q_measured, kin.dt, rest_band(kin.resolution, kin.noise)):     # the rest [a, b]
         lo = a + (b - a) // 2
         out[a:b + 1] = float(np.median(F[lo:max(b + 1 - guard, lo + 1)]))
