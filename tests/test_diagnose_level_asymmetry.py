@@ -71,3 +71,10 @@ def test_a_level_pushing_along_the_motion_is_not_physical():
     model = _model()
     assert level_asymmetry.unphysical(np.array([0.1, -0.2]), {}, model) is None
     assert "pushing along the motion" in level_asymmetry.unphysical(np.array([0.1, -1.2]), {}, model)
+
+
+def test_sentence_names_each_direction_and_skips_an_unchanged_one():
+    model = _model()
+    text = level_asymmetry.sentence(level_asymmetry.parameters(np.array([0.001, -0.28]), {}, model), {}, model)
+    assert "for positive velocities the model's (Fc = 10 N, Fs = 15 N)" in text
+    assert "for negative velocities 28 % lower than the model's (Fc = 7.2 N, Fs = 10.8 N instead of 10 N, 15 N)" in text

@@ -92,9 +92,11 @@ def sentence(p, inc, model) -> str:
     parts = []
     for side, key, c in (("positive", "pos", model.curve.positive), ("negative", "neg", model.curve.negative)):
         k = p[f"scale_{key}"]
-        levels = (f"Fc = {_q(p[f'Fc_{key}'], None, 'N')}, Fs = {_q(p[f'Fs_{key}'], None, 'N')} instead of "
-                  f"{_q(c.Fc, None, 'N')}, {_q(c.Fs, None, 'N')}")
-        how = "the model's" if abs(k - 1) < 0.005 else (f"{k:.3g} times the model's" if k >= 1.5 or k <= 0.5 else
-                                                         f"{_pct(abs(k - 1))} {'higher' if k > 1 else 'lower'} than the model's")
-        parts.append(f"for {side} velocities {how} ({levels})")
+        levels = f"Fc = {_q(p[f'Fc_{key}'], None, 'N')}, Fs = {_q(p[f'Fs_{key}'], None, 'N')}"
+        if abs(k - 1) < 0.005:
+            parts.append(f"for {side} velocities the model's ({levels})")
+            continue
+        how = (f"{k:.3g} times the model's" if k >= 1.5 or k <= 0.5 else
+               f"{_pct(abs(k - 1))} {'higher' if k > 1 else 'lower'} than the model's")
+        parts.append(f"for {side} velocities {how} ({levels} instead of {_q(c.Fc, None, 'N')}, {_q(c.Fs, None, 'N')})")
     return "the friction level differs between the directions: " + "; ".join(parts)
