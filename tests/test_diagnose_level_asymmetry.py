@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from hunting.diagnose import Measurement, NominalModel, kinematics
-from hunting.diagnose.causes import CAUSES, level, level_asymmetry
+from hunting.diagnose.causes import CAUSES, level, level_asymmetry, offset
 
 DT = 1e-3
 STRIBECK = {"plant": {"mass": 1.0, "motor_constant": 1.0},
@@ -78,3 +78,16 @@ def test_sentence_names_each_direction_and_skips_an_unchanged_one():
     text = level_asymmetry.sentence(level_asymmetry.parameters(np.array([0.001, -0.28]), {}, model), {}, model)
     assert "for positive velocities the model's (Fc = 10 N, Fs = 15 N)" in text
     assert "for negative velocities 28 % lower than the model's (Fc = 7.2 N, Fs = 10.8 N instead of 10 N, 15 N)" in text
+
+
+def test_an_offset_is_nearly_in_its_span_above_the_stribeck_velocity_and_excluded():
+    """Sliding well above vs the levels are Fc, and levels moved apart are a constant force: the
+    offset's regressor is fitted by the two columns to within 5 % RMS (a set holding both cancels
+    them against each other, reporting31 d0125), so the two are never in one set."""
+    model = _model(vs=0.002)
+    kin = _kin(_sine(amp=0.02))
+    X = level_asymmetry.design(kin, model, {})
+    y = offset.design(kin, model, {})[:, 0]
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    assert np.sqrt(np.mean((y - X @ coef) ** 2)) < 0.05 * np.sqrt(np.mean(y ** 2))
+    assert "offset" in level_asymmetry.EXCLUDES
