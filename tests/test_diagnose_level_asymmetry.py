@@ -27,12 +27,18 @@ def _model(**friction):
     return NominalModel.from_dict(dict(STRIBECK, friction=dict(STRIBECK["friction"], **friction)))
 
 
-@pytest.mark.parametrize("theta", [(0.2, -0.3), (0.0, 0.5), (-0.4, 0.0)])
-def test_regressor_is_the_extension_change_of_the_sliding_friction(theta):
+# the negative direction's own curve: each column must read its own direction's level
+ASYMMETRIC = {"Fc_neg": 6.0, "Fs_neg": 12.0, "vs_neg": 0.02, "b_neg": 30.0}
+
+
+@pytest.mark.parametrize("theta, curve", [((0.2, -0.3), {}), ((0.0, 0.5), {}), ((-0.4, 0.0), {}),
+                                          ((0.2, -0.3), ASYMMETRIC), ((-0.1, 0.4), ASYMMETRIC)])
+def test_regressor_is_the_extension_change_of_the_sliding_friction(theta, curve):
     """design @ theta equals the extended model's sliding friction less the nominal one's, both from
     the curves' force law (DirectionalCurve.force), on every sample of a two-way sine (with the
-    sliding mask and filter of the force channel), and the parameters are the extension's levels."""
-    model = _model()
+    sliding mask and filter of the force channel), and the parameters are the extension's levels;
+    on a symmetric nominal curve and on one whose directions differ."""
+    model = _model(**curve)
     kin = _kin(_sine())
     X = level_asymmetry.design(kin, model, {})
     ext = level_asymmetry.extend(model, np.array(theta), {})
@@ -62,6 +68,7 @@ def test_untestable_without_a_dip_one_way_or_without_friction():
     two_way, one_way = _kin(_sine()), _kin(np.linspace(0.0, 0.05, 3000))
     assert level_asymmetry.untestable(two_way, _model()) is None
     assert "no Stribeck dip" in level_asymmetry.untestable(two_way, _model(Fs=10.0))
+    assert "no Stribeck dip" in level_asymmetry.untestable(two_way, _model(beta=float("inf")))
     assert "moves one way only" in level_asymmetry.untestable(one_way, _model())
     assert level_asymmetry.untestable(one_way, _model(), validation=True) is None
     assert "no Coulomb or static friction" in level_asymmetry.untestable(two_way, _model(Fc=0.0, Fs=0.0))

@@ -15,7 +15,8 @@ class _Lib:
 
     def __init__(self, rms: dict):
         self.rms = rms
-        self.variants = {"offset": [{}], "asymmetry": [{}], "viscous": [{}], "level": [{}], "stribeck": [{}]}
+        self.variants = {"offset": [{}], "asymmetry": [{}], "viscous": [{}], "level": [{}], "stribeck": [{}],
+                         "level_asymmetry": [{}], "mass": [{}]}
 
     def best_variants(self, names):
         return Explanation(tuple((n, 0) for n in names), np.zeros(0), 0.0, 0.0)
@@ -56,6 +57,20 @@ def test_a_general_cause_gives_way_to_its_special_case_unless_needed(general, sp
         assert to_general is not None and to_general[0] == special and general in to_general[1].names
     # a cause dropped for good is not brought back
     assert force._special_case(lib, {}, cur_g, rms_general, 0.05, {special}) is None
+
+
+@pytest.mark.parametrize("rms_stribeck, rms_apart, expect", [(0.80, 0.90, "stribeck"), (0.90, 0.80, "level_asymmetry"),
+                                                              (0.97, 0.99, None)])
+def test_of_two_general_causes_the_better_one_replaces_the_special_case(rms_stribeck, rms_apart, expect):
+    """``level`` is the special case of ``stribeck`` and of ``level_asymmetry``: the one that explains
+    the validation data best takes its place, where it is better by min_gain."""
+    lib = _Lib({frozenset({"mass", "level"}): 1.0, frozenset({"mass", "stribeck"}): rms_stribeck,
+                frozenset({"mass", "level_asymmetry"}): rms_apart})
+    out = force._general_case(lib, {}, _current("mass", "level"), 1.0, 2.0, 0.05, set())
+    if expect is None:
+        assert out is None
+    else:
+        assert out[0] == "level" and set(out[1].names) == {"mass", expect} and out[2].startswith(expect)
 
 
 def test_a_swap_at_the_noise_floor_keeps_the_selected_special_case():

@@ -67,7 +67,7 @@ from .stats import NoiseModel, Samples, out_of_sample
 
 PRECISION = 1e-4      # a cause must remove more than this fraction of the drive force's RMS
 # a change of the friction force's level or curve (FRICTION_FORCE causes: offset, asymmetry, level,
-# stribeck, viscous, dwell_peak) must move the predicted force by at least this fraction of the Coulomb level
+# level_asymmetry, stribeck, viscous, dwell_peak) must move the predicted force by at least this fraction of the Coulomb level
 # (RMS on the validation record's sliding samples): a friction force is neither known nor steady
 # to better than that, and a change below it is no cause an engineer would name. Fixed on the
 # development sets (reporting17-20): on clean records, where the generator's truth is the nominal

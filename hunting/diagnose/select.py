@@ -13,12 +13,13 @@ The rule (stated in every report, :data:`RULE`):
   explains at least REFERENCE_GAIN x min_gain of it: feedback puts the sensor's and the
   actuator's noise into the measured regressors, not into the reference's),
   dropping it grows the validation RMS by at least ``min_gain``, a change of the friction force
-  itself (``FRICTION_FORCE``: offset, asymmetry, level, stribeck, viscous) moves the
+  itself (``FRICTION_FORCE``: offset, asymmetry, level, level_asymmetry, stribeck, viscous,
+  dwell_peak) moves the
   predicted force by at least ``RELEVANCE`` of the Coulomb level, and the whole set beats each of
   its subsets by as much; what fails is removed and the rest refitted, and when nothing of the
   set holds, the BIC-best set without the causes that failed is judged next; a special case
-  (level) gives way to the general cause of its family (stribeck) when that explains the
-  validation data better by ``min_gain``
+  (level) gives way to the general cause of its family (stribeck or level_asymmetry, the better
+  one) when that explains the validation data better by ``min_gain``
   (:mod:`hunting.diagnose.force`, :mod:`hunting.diagnose.stats`);
 - causes with their own evidence (``CHANNEL = "own"``: dwell, saturation, quantization) bring a
   statistic with its p-value and a validation metric of their own (module docstrings); the same
@@ -535,7 +536,12 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
     judged = _identified_force_channel(_library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None),
                                        list(cross) + found + mates, model, max_causes, alpha, min_gain,
                                        alpha_reference, inner)
+    from .force import compatible
     held = [n for n in cross if n in {c.name for c in judged["causes"]}]
+    # a cross cause kept in place of a found one it excludes would be refitted on top of it
+    # (level_asymmetry, untestable on a one-way fitting record, over an offset found there)
+    clash = {n: [c for c in found if not compatible([n, c])] for n in held}
+    held = [n for n in held if not clash[n]]
     fc2 = dict(causes=[], model=ext, alternatives=[], explanations=[], rejected=[])
     if held:
         # their parameters on top of the model the fitting data extended
@@ -546,6 +552,8 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
         r for r in fc2["rejected"] if r["name"] in cross]
     fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "
                                                           "data") for n in held if n not in kept]
+    fc2["rejected"] += [dict(name=n, step="refit", reason=f"it cannot be combined with {', '.join(c)}, found on the "
+                                                          "fitting data") for n, c in clash.items() if c]
     for c in judged["causes"]:
         if c.name not in cross and c.name not in found:
             fc2["rejected"] = [dict(r, reason=f"{r['reason']}; {c.name} explains these data in its place")

@@ -113,7 +113,8 @@ def rest_force(kin, model) -> np.ndarray:
     # pieces of at most 13 ms on reporting8 d0477 at 5 kHz, none long enough to count), and the
     # smoothed positions round a rest's corners off (reporting29 d0421: sigma0 1.19 -> 1.00 times
     # the truth read from the measured ones)
-    for a, b in rest_phases(kin.q_measured, kin.dt, rest_band(kin.resolution, kin.noise)):     # the rest [a, b]
+    q = kin.q if kin.q_measured is None else kin.q_measured
+    for a, b in rest_phases(q, kin.dt, rest_band(kin.resolution, kin.noise)):     # the rest [a, b]
         lo = a + (b - a) // 2
         out[a:b + 1] = float(np.median(F[lo:max(b + 1 - guard, lo + 1)]))
     out.setflags(write=False)
