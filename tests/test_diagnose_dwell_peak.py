@@ -167,3 +167,20 @@ def test_extension_is_the_seven_parameter_dwell():
     ext = dwell_peak.extend(m, np.array([2.0]), {"time": 0.3})
     assert ext.dwell == Dwell(0.0, 2.0, 0.3, sliding=True)
     assert "fall with the rest" in dwell_peak.unphysical(np.array([-1.0]), {"time": 0.3}, m)
+
+
+def test_the_reversal_reads_the_same_rests_from_the_measured_positions():
+    """reversal.rest_force holds a force exactly on the rests dwell.kinematics_rests reads from the
+    measured positions (those dwell_peak's slips start from); the smoothed positions' rests are
+    shorter (rounded corners), so reading them would have moved every rest's ends."""
+    from hunting.diagnose.behaviour import stick_phases
+    from hunting.diagnose.causes import reversal
+    m, kin, _ = _record(2.0)
+    rests = dwell.kinematics_rests(kin)
+    held = np.isfinite(reversal.rest_force(kin, m))
+    mask = np.zeros(kin.t.size, bool)
+    for a, b in rests:
+        mask[a:b + 1] = True
+    assert len(rests) >= 4 and np.array_equal(held, mask)
+    smoothed = stick_phases(kin.q, kin.dt, dwell.rest_band(kin.resolution, kin.noise), window=dwell.REST_WINDOW)
+    assert sum(b - a for a, b in smoothed) < sum(b - a for a, b in rests)

@@ -34,6 +34,14 @@ def with_curves(model: NominalModel, pos, neg=None) -> NominalModel:
     return model.replace(curve=DirectionalCurve(pos(model.curve.positive), neg(model.curve.negative)))
 
 
+def two_way_share(kin) -> float:
+    """The smaller share of a record's sliding samples in one direction (0 for a record that does
+    not slide): causes whose fit needs both directions (asymmetry, level, level_asymmetry) want 10 %."""
+    import numpy as np
+    v = kin.v[kin.moving]
+    return float(min(np.mean(v > 0), np.mean(v < 0))) if v.size else 0.0
+
+
 from . import (asymmetry, cogging, delay, dwell, dwell_peak, flexibility, lag, level, level_asymmetry, mass, offset,  # noqa: E402
                presliding, quantization, reversal, saturation, stribeck, viscous)
 

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import with_curves
+from . import two_way_share, with_curves
 from ._words import _pct, _q
 
 NAME = "asymmetry"
@@ -33,8 +33,7 @@ def untestable(kin, model, validation: bool = False) -> str | None:
     on both ways no change)."""
     if validation:
         return None
-    v = kin.v[kin.moving]
-    share = min(np.mean(v > 0), np.mean(v < 0)) if v.size else 0.0
+    share = two_way_share(kin)
     return None if share >= 0.1 else f"the record moves one way only ({share:.0%} of the sliding samples the other way)"
 
 

@@ -391,6 +391,14 @@ def rest_phases(q: np.ndarray, dt: float, band: float) -> list:
     return stick_phases(q, dt, band, window=REST_WINDOW)
 
 
+def kinematics_rests(kin) -> list:
+    """The rests (:func:`rest_phases`) of a Kinematics ``kin``, read from its measured positions
+    (the smoothed ``kin.q`` rounds a rest's corners off; ``kin.q`` where none are kept) in the band
+    of its sensor (:func:`rest_band`)."""
+    q = kin.q if kin.q_measured is None else kin.q_measured
+    return rest_phases(q, kin.dt, rest_band(kin.resolution, kin.noise))
+
+
 def _unasked(out: dict) -> str:
     """Why the growth verdict ``out`` (:func:`_growth_verdict`) did not ask the loop, in words."""
     if "reason" in out:        # too few rests, rests of one length, or a fitted growth that falls

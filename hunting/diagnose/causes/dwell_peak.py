@@ -21,7 +21,7 @@ import numpy as np
 
 from ..model import Dwell
 from ._words import _q
-from .dwell import rest_band, rest_phases
+from .dwell import kinematics_rests
 
 NAME = "dwell_peak"
 DESCRIPTION = "dwell in the seven-parameter form: the Stribeck peak of each slip grows with the rest before it"
@@ -46,8 +46,7 @@ def slip_rests(kin) -> np.ndarray:
     if hit is not None and hit[0] is kin:
         return hit[1]
     n = kin.t.size
-    q = kin.q if kin.q_measured is None else kin.q_measured       # the smoothed q rounds a rest's corners off
-    phases = rest_phases(q, kin.dt, rest_band(kin.resolution, kin.noise))
+    phases = kinematics_rests(kin)
     ends = np.array([b for _, b in phases], dtype=int)
     durations = np.array([np.inf if a == 0 else (b - a + 1) * kin.dt for a, b in phases])
     fast = np.flatnonzero(np.abs(kin.vf) > TURN_SPEED * np.max(np.abs(kin.vf)))

@@ -22,7 +22,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import with_curves
+from . import two_way_share, with_curves
 from ._words import _pct, _q
 
 NAME = "level"
@@ -48,8 +48,7 @@ def untestable(kin, model, validation: bool = False) -> str | None:
     pos, neg = model.curve.positive, model.curve.negative
     if pos.Fc <= 0 and neg.Fc <= 0 and pos.Fs <= 0 and neg.Fs <= 0:
         return "the nominal model has no Coulomb or static friction to scale (offset, stribeck or asymmetry add it)"
-    v = kin.v[kin.moving]
-    share = min(np.mean(v > 0), np.mean(v < 0)) if v.size else 0.0
+    share = two_way_share(kin)
     if share < 0.1 and pos.Fs == pos.Fc and neg.Fs == neg.Fc and not validation:
         return (f"the record moves one way only ({share:.0%} of the sliding samples the other way): a level common "
                 "to both directions of a curve without a Stribeck dip is a constant force (offset) there")

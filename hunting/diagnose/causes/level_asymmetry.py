@@ -24,7 +24,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import with_curves
+from . import two_way_share, with_curves
 from ._words import _pct, _q
 
 NAME = "level_asymmetry"
@@ -53,9 +53,9 @@ def hypers(kin, model) -> list:
 
 def untestable(kin, model, validation: bool = False) -> str | None:
     """No Stribeck dip on either direction (Fs = Fc, or a discontinuous curve whose sliding level
-    is Fc: module docstring, the change is then a level and a constant force), no level to scale, or a fitting record that moves one way only (less than
-    MIN_SHARE of the sliding samples the other way; a validation record, ``validation``, still
-    judges the factors fitted on another)."""
+    is Fc: module docstring, the change is then a level and a constant force), no level to scale,
+    or a fitting record that moves one way only (less than MIN_SHARE of the sliding samples the
+    other way; a validation record, ``validation``, still judges the factors fitted on another)."""
     pos, neg = model.curve.positive, model.curve.negative
     if pos.Fc <= 0 and neg.Fc <= 0 and pos.Fs <= 0 and neg.Fs <= 0:
         return "the nominal model has no Coulomb or static friction to scale"
@@ -64,19 +64,16 @@ def untestable(kin, model, validation: bool = False) -> str | None:
                 "and a constant force there (level and offset)")
     if validation:
         return None
-    v = kin.v[kin.moving]
-    share = min(np.mean(v > 0), np.mean(v < 0)) if v.size else 0.0
+    share = two_way_share(kin)
     return None if share >= MIN_SHARE else f"the record moves one way only ({share:.0%} of the sliding samples the other way)"
 
 
 def design(kin, model, hyper):
     """(n, 2) [N]: the nominal level g+(|v|) on the positive velocities, -g-(|v|) on the negative."""
+    from .level import _levels
     v = kin.vf
-    pos, neg = np.zeros_like(v), np.zeros_like(v)
-    p, n = v > 0, v < 0
-    pos[p] = model.curve.positive.level(v[p])
-    neg[n] = -model.curve.negative.level(-v[n])
-    return kin.sliding(np.column_stack([pos, neg]))
+    g = _levels(v, model)
+    return kin.sliding(np.column_stack([np.where(v > 0, g, 0.0), np.where(v < 0, g, 0.0)]))
 
 
 def unphysical(theta, hyper, model) -> str | None:

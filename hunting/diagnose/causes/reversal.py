@@ -101,7 +101,7 @@ def rest_force(kin, model) -> np.ndarray:
     loop of the tests, whose bristles carried a steady 18 N), and before the position leaves its
     count the mass already accelerates. Shorter sticks are turnarounds the position reads as a
     stick, which the bristles pass through integrated (their drive is mostly inertia)."""
-    from .dwell import rest_band, rest_phases
+    from .dwell import kinematics_rests
     hit = _REST_CACHE.get(id(kin))
     if hit is not None and hit[0] is kin and hit[1] is model:
         return hit[2]
@@ -113,8 +113,7 @@ def rest_force(kin, model) -> np.ndarray:
     # pieces of at most 13 ms on reporting8 d0477 at 5 kHz, none long enough to count), and the
     # smoothed positions round a rest's corners off (reporting29 d0421: sigma0 1.19 -> 1.00 times
     # the truth read from the measured ones)
-    q = kin.q if kin.q_measured is None else kin.q_measured
-    for a, b in rest_phases(q, kin.dt, rest_band(kin.resolution, kin.noise)):     # the rest [a, b]
+    for a, b in kinematics_rests(kin):     # the rest [a, b]
         lo = a + (b - a) // 2
         out[a:b + 1] = float(np.median(F[lo:max(b + 1 - guard, lo + 1)]))
     out.setflags(write=False)
