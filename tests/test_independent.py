@@ -75,3 +75,21 @@ def test_one_direction_level_scaled_is_named_as_such(records):
     p = dg.causes[0].parameters
     assert p["Fc_neg"] == pytest.approx(truth["params"]["Fc_neg"], rel=0.01)
     assert p["Fc_pos"] == pytest.approx(truth["params"]["Fc_pos"], rel=0.01)
+
+
+def test_a_noise_free_clean_record_gets_reasons_in_words_not_relative_changes_of_nothing(records):
+    """d0004 is the nominal model's own noise-free loop: the validation force residual and the
+    re-simulated position error are exactly 0. The reasons said a cause 'changes the validation
+    residual by -100.0%' (0 over 0), a dwell growth 'cuts the position error by -999.0%' and a
+    'validation gain -5.3e+293%' (a ratio to 1e-300); they say what happened now, and the JSON
+    is strict (no NaN or Infinity)."""
+    import re
+    from hunting.diagnose.report import format_terminal
+    truth, dg = _diagnosis(records, 4)
+    assert truth["clean"] and dg.causes == [] and dg.nominal == 0.0
+    text = format_terminal(dg)
+    assert not re.search(r"-100\.0%|999\.0%|inf%|nan|e\+\d\d\d?%", text), text
+    reasons = {r["name"]: r["reason"] for r in dg.rejected}
+    assert "validation residual (0 N RMS) is at numerical precision" in reasons["stribeck"]
+    assert "makes its re-simulated position error" in reasons["dwell"] and "against 0 m without" in reasons["dwell"]
+    json.dumps(dg.as_dict(), allow_nan=False)

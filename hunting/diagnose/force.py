@@ -63,7 +63,7 @@ import numpy as np
 from .causes import CAUSES, hyper_count, hyper_keys, untestable
 from .kinematics import Kinematics, residual
 from .model import NominalModel
-from .stats import NoiseModel, Samples, out_of_sample
+from .stats import NoiseModel, Samples, out_of_sample, relative_fall
 
 PRECISION = 1e-4      # a cause must remove more than this fraction of the drive force's RMS
 # a change of the friction force's level or curve (FRICTION_FORCE causes: offset, asymmetry, level,
@@ -577,10 +577,18 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
         if name in last or name in current.names:
             continue
         alone = fits[(name,)]
-        gain = 1 - lib.validation_rms(alone) / max(rms0, 1e-300)
-        last[name] = dict(name=name, step="search", statistic=None, p_value=None, validation_gain=gain,
+        rms_alone = lib.validation_rms(alone)
+        gain = relative_fall(rms0, rms_alone)
+        if at_precision(rms0, floor):
+            # a noise-free record of the nominal model itself: no relative change to quote
+            on_val = (f"the nominal model's validation residual ({rms0:.3g} N RMS) is at numerical precision "
+                      f"(with it {rms_alone:.3g} N RMS)")
+        else:
+            on_val = f"the validation residual by {-gain:+.1%}"
+        last[name] = dict(name=name, step="search", statistic=None, p_value=None,
+                          validation_gain=gain if np.isfinite(gain) else None,
                           reason=f"not in the best explanation: alone it changes the fitting data's BIC by "
-                                 f"{alone.bic - fits[()].bic:+.1f} and the validation residual by {-gain:+.1%}")
+                                 f"{alone.bic - fits[()].bic:+.1f} and {on_val}")
     return dict(explanation=current, tests=tests if current.members else {}, rejected=list(last.values()),
                 ranking=ranking, noise_val=noise_v, fits=fits)
 

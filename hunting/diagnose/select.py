@@ -68,6 +68,7 @@ from .causes import CAUSES, untestable
 from .data import Measurement
 from .kinematics import Kinematics, kinematics, reference_kinematics, used_samples
 from .loop_sigma import parameter_sigma
+from .stats import relative_fall
 from .model import NominalModel
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
@@ -198,15 +199,29 @@ class Diagnosis:
         return out
 
     def as_dict(self) -> dict:
+        """The diagnosis as plain data for JSON: every number finite (a value that is not, e.g. the
+        gain of an extension whose loop does not re-simulate, is None; its row's reason says why)."""
         alts = [dict(a, score=0.0, role="alternative") for a in self.alternatives]
-        return dict(causes=[c.as_dict() for c in self.causes] + alts,
+        return _finite(dict(causes=[c.as_dict() for c in self.causes] + alts,
                     gain=dict(metric="force residual RMS [N] on the validation data", nominal=self.nominal,
                               extended=self.extended),
                     gains=self.gains(), behaviour=self.behaviour, notes=self.notes,
                     criterion=self.criterion, rule=self.criterion, rejected=self.rejected,
                     alternatives=self.alternatives, explanations=self.explanations, untested=self.untested,
                     nominal_model=self.model.to_dict(),
-                    extended_model=None if self.extended_model is None else self.extended_model.to_dict())
+                    extended_model=None if self.extended_model is None else self.extended_model.to_dict()))
+
+
+def _finite(x):
+    """``x`` (nested dicts, lists and tuples) with every float that is not finite replaced by None
+    (strict JSON has no NaN or Infinity)."""
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    if isinstance(x, (float, np.floating)) and not np.isfinite(x):
+        return None
+    return x
 
 
 def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
@@ -932,7 +947,7 @@ def _found_family(names, found: list) -> bool:
 
 def _own_gain(v: dict) -> float:
     """The relative fall of an own-evidence verdict's validation metric, nominal to extended."""
-    return 1 - v["extended"] / max(v["nominal"], 1e-300)
+    return relative_fall(v["nominal"], v["extended"])
 
 
 def _own_failure(v: dict, alpha: float, min_gain: float) -> str | None:
@@ -948,8 +963,22 @@ def _own_failure(v: dict, alpha: float, min_gain: float) -> str | None:
     elif v["p_value"] >= alpha:
         why.append(f"p = {v['p_value']:.2g} >= {alpha:g}")
     if gain < min_gain:
-        why.append(f"validation gain {gain:.1%} < {min_gain:.0%}")
+        why.append(_gain_words(v["nominal"], v["extended"], min_gain, v["metric"]))
     return " and ".join(why) or None
+
+
+def _gain_words(before: float, after: float, min_gain: float, metric: str) -> str:
+    """Why a validation ``metric`` (its name with the unit in brackets) that went from ``before``
+    to ``after`` does not admit a cause: its relative fall below ``min_gain``, or, where that
+    means nothing, what happened."""
+    from .causes._words import _q
+    if not np.isfinite(after):
+        return "the extension does not re-simulate the validation record"
+    if before <= 0:
+        unit = metric.split("[")[-1].split("]")[0] if "[" in metric else ""
+        return (f"the nominal model reproduces the validation record exactly ({metric.split(' [')[0]} 0 {unit}; "
+                f"{_q(after, None, unit)} with the extension)")
+    return f"validation gain {relative_fall(before, after):.1%} < {min_gain:.0%}"
 
 
 def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
@@ -990,9 +1019,9 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
             return reject(reason="no stick segments in the validation data")
         before, after = mod.displacement_rms(kv, model, sv, theta)
         metric = "stick-segment displacement RMS [m], validation"
-    gain = 1 - after / max(before, 1e-300)
+    gain = relative_fall(before, after)
     if gain < min_gain:
-        return reject(gain, f"validation gain {gain:.1%} < {min_gain:.0%}")
+        return reject(gain, _gain_words(before, after, min_gain, metric))
     pars = mod.parameters(theta, {}, model)
     sig = {k: None for k in pars}
     if can_sim and hasattr(mod, "log_sigma0_sigma"):
@@ -1016,7 +1045,7 @@ def _loop_channel(mod, fit, val, model, can_sim, test, why):
         return None, dict(name=mod.NAME, step="stick", statistic=chi2, p_value=p, validation_gain=None, reason=why), model
     v = mod.loop_evidence(fit, val, model)
     if "reason" in v:
-        gain = (1 - v["val"][1] / v["val"][0]) if "val" in v else None
+        gain = relative_fall(*v["val"]) if "val" in v else None
         return None, dict(name=mod.NAME, step="loop", statistic=chi2, p_value=p, validation_gain=gain,
                           reason=f"{why}; and {v['reason']}"), model
     theta, hyper = v["theta"], v.get("hyper", {})

@@ -35,6 +35,18 @@ SCALE_HALF = 10     # half width of the moving RMS giving the local level [thinn
 IV_LAGS = 40        # lags of the instrumented estimate's covariance (an unwhitened residual) [thinned samples]
 
 
+def relative_fall(before: float, after: float) -> float:
+    """The relative fall 1 - after / before of an error measure (a validation residual's RMS, a
+    re-simulated position error): 0 where both are 0 (nothing to explain and nothing added: a
+    noise-free record of the nominal model itself), -inf where only ``before`` is 0 or ``after``
+    is not finite (a re-simulation that failed)."""
+    if not np.isfinite(after):
+        return -np.inf
+    if before <= 0:
+        return 0.0 if after <= 0 else -np.inf
+    return 1.0 - after / before
+
+
 @dataclass(frozen=True)
 class Samples:
     """The thinned samples of one record: idx (m,) indices into the record's arrays, run (m,)

@@ -1,6 +1,11 @@
 """Numbers in engineering form for the reports: rounded values with SI prefixes and units, a
-value with its standard uncertainty rounded to the uncertainty's second digit."""
+value with its standard uncertainty rounded to the uncertainty's second digit, and how an
+extension moved an error measure."""
 import math
+
+import numpy as np
+
+from ..stats import relative_fall
 
 _PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"))
 _PREFIXED = {"m", "s", "N", "Hz", "V", "m/s", "N/m"}
@@ -44,3 +49,18 @@ def _pct(x: float) -> str:
 def _count(n: int, noun: str, plural: str | None = None) -> str:
     """'1 sample', '0 samples', '3 rests': a count with its noun in the right number."""
     return f"{n} {noun if n == 1 else (plural or noun + 's')}"
+
+
+def cut_words(before: float, after: float, what: str, plural: bool = False) -> str:
+    """How an extension moved ``what`` (a re-simulated position RMS error) from ``before`` to
+    ``after`` [m], in words: the relative cut where it means something; both errors where the
+    nominal model's is 0 (a noise-free record of the nominal model itself) or the extension makes
+    it more than tenfold worse; the failure where a loop does not re-simulate. The verb agrees with
+    a ``plural`` subject (e.g. "LuGre bristles cut")."""
+    if not np.isfinite(before) or not np.isfinite(after):
+        return f"cannot be judged by {what}: the {'nominal ' if not np.isfinite(before) else ''}loop does not re-simulate"
+    gain = relative_fall(before, after)
+    if before <= 0 or gain < -9.0:
+        return (f"{'make' if plural else 'makes'} {what} {_q(after, None, 'm')} against {_q(before, None, 'm')} "
+                f"without {'them' if plural else 'it'}")
+    return f"{'cut' if plural else 'cuts'} {what} by {gain:.1%}"

@@ -46,6 +46,8 @@ Nelder-Mead on log gain and log time, at most GAINS x TIMES + EVALS re-simulatio
 """
 import numpy as np
 
+from ..stats import relative_fall
+from ._words import cut_words
 from .presliding import LOOP_GAIN, LOOP_VALIDATION_GAIN
 
 GATE = 0.2           # the growth test's p below which the loop is asked
@@ -204,9 +206,9 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
                              "or the loop does not re-simulate)",
                     parameters={}, sigma={}, metric="re-simulated position RMS error [m], validation",
                     nominal=v0, extended=v0, model=model)
-    gain_f = 1.0 - f1 / f0 if np.isfinite(f0) and f0 > 0 and np.isfinite(f1) else -np.inf
+    gain_f = relative_fall(f0, f1) if np.isfinite(f0) else -np.inf
     v0, v1 = position_rms_error(val_meas, model), position_rms_error(val_meas, loop["model"])
-    gain_v = 1.0 - v1 / v0 if np.isfinite(v0) and v0 > 0 and np.isfinite(v1) else -np.inf
+    gain_v = relative_fall(v0, v1) if np.isfinite(v0) else -np.inf
     d = loop["model"].dwell
     ok = gain_f >= LOOP_GAIN and gain_v >= LOOP_VALIDATION_GAIN
     if ok:
@@ -215,11 +217,12 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
                  f"{form_words(d)}) follows both records better: position RMS error -{gain_f:.0%} "
                  f"fitting, -{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} needed)")
     elif gain_f < LOOP_GAIN:
-        words = (f"fitted on the fitting record's loop the growth cuts its re-simulated position error by "
-                 f"{max(gain_f, -9.99):.1%} ({LOOP_GAIN:.0%} needed)")
+        words = (f"fitted on the fitting record's loop the growth {cut_words(f0, f1, 'its re-simulated position error')} "
+                 f"({LOOP_GAIN:.0%} needed)")
     else:
-        words = (f"fitted on the fitting record's loop ({gain_f:.1%} there) the growth cuts the validation record's "
-                 f"position error by {max(gain_v, -9.99):.1%} ({LOOP_VALIDATION_GAIN:.0%} needed)")
+        cut = cut_words(v0, v1, "the validation record's position error")
+        words = (f"fitted on the fitting record's loop ({gain_f:.1%} there) the growth {cut} "
+                 f"({LOOP_VALIDATION_GAIN:.0%} needed)")
     sig = (sigma(loop["model"], fit_meas, val_meas, model, rest_times) if ok and fit_meas is not None
            else {"level": None, "gain": None, "time": None})
     return dict(statistic=float(gain_f), p_value=None, significant=ok, evidence=words,

@@ -34,7 +34,8 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from ..loop_sigma import coefficient_sigma, two_records
-from ._words import _q
+from ..stats import relative_fall
+from ._words import _q, cut_words
 
 NAME = "presliding"
 DESCRIPTION = "finite stick stiffness: motion while |F| < Fs (LuGre sigma0)"
@@ -292,21 +293,22 @@ def loop_evidence(fit, val, model) -> dict:
     (theta, f1), zeta = min(fits, key=lambda fz: fz[0][1])
     hyper = {"zeta": zeta}
     out = dict(theta=theta, fit=(f0, f1), hyper=hyper)
-    gain_f = 1.0 - f1 / f0 if np.isfinite(f0) and f0 > 0 else -np.inf
+    gain_f = relative_fall(f0, f1) if np.isfinite(f0) else -np.inf
     sigma0 = 1.0 / theta[0]
     if sigma0 > bound:
         return dict(out, reason=(f"the loop's best bristles (sigma0 = {sigma0:.3g} N/m) build up over less than "
                                  f"{LOOP_STEPS:g} sensor steps (sigma0 above {bound:.3g} N/m)"))
     if gain_f < LOOP_GAIN:
-        return dict(out, reason=(f"LuGre bristles cut the fitting record's re-simulated position error by {gain_f:.1%} "
-                                 f"(at sigma0 = {sigma0:.3g} N/m, zeta = {zeta:g}; {LOOP_GAIN:.0%} needed)"))
+        cut = cut_words(f0, f1, "the fitting record's re-simulated position error", plural=True)
+        return dict(out, reason=(f"LuGre bristles {cut} (at sigma0 = {sigma0:.3g} N/m, zeta = {zeta:g}; "
+                                 f"{LOOP_GAIN:.0%} needed)"))
     v0, v1 = position_rms_error(val, model), position_rms_error(val, extend(model, theta, hyper))
-    gain_v = 1.0 - v1 / v0 if np.isfinite(v0) and v0 > 0 else -np.inf
+    gain_v = relative_fall(v0, v1) if np.isfinite(v0) else -np.inf
     out["val"] = (v0, v1)
     if gain_v < LOOP_VALIDATION_GAIN:
+        cut_v = cut_words(v0, v1, "the validation record's position error", plural=True)
         return dict(out, reason=(f"LuGre bristles fitted on the fitting record's loop (sigma0 = {sigma0:.3g} N/m, "
-                                 f"zeta = {zeta:g}, {gain_f:.1%} there) cut the validation record's position error "
-                                 f"by {gain_v:.1%} ({LOOP_VALIDATION_GAIN:.0%} needed)"))
+                                 f"zeta = {zeta:g}, {gain_f:.1%} there) {cut_v} ({LOOP_VALIDATION_GAIN:.0%} needed)"))
     out["sigma_lg"] = log_sigma0_sigma(fit, val, model, theta, None, None, hyper)
     return dict(out, evidence=(f"the loop re-simulated with LuGre bristles (sigma0 and the damping ratio zeta = "
                                f"{zeta:g} of {', '.join(f'{z:g}' for z in LOOP_ZETAS)} fitted on the fitting record's "
