@@ -564,3 +564,18 @@ def test_dwell_seven_parameter_form_needs_a_stribeck_curve():
         NominalModel.from_dict(d)
     del d["friction"]["dwell"]["sliding"]
     assert NominalModel.from_dict(d).dwell.sliding is False
+
+
+@pytest.mark.parametrize("gain, words", [(-4.9e-18, "the break-away force does not change with the rest: not"),
+                                         (-0.745, "falls with the rest in the fitting data (gain -0.745 N)")])
+def test_dwell_growth_at_the_fits_rounding_does_not_fall(gain, words, monkeypatch):
+    """reporting32 d0621 (identical break-away readings): the fitted gain -4.9e-18 N was reported
+    as a break-away force that 'falls with the rest'; a gain at the fit's rounding does not change
+    it, a real negative gain still falls."""
+    from hunting.diagnose.synthetic import TruePlant, true_model
+    model = true_model(TruePlant(Fs=22.0))
+    monkeypatch.setattr(dwell, "_fit", lambda t, e, lo=-np.inf: ((1.0, np.array([0.3, gain]), 0.1), 2.0))
+    t = np.geomspace(0.05, 2.0, 8)
+    F, s = np.full(8, 22.3), np.ones(8)
+    v = dwell._growth_verdict(t, F, s, s, t[:4], F[:4], s[:4], s[:4], model)
+    assert words in v["reason"]

@@ -752,8 +752,10 @@ def _growth_verdict(t, F, s, scale, tv, Fv, sv, scale_v, model) -> dict:
     lo = lowest_level(model)
     (ss, th, tau), ss0 = _fit(t, e, lo)
     if th[1] <= 0:
-        return dict(out, reason=f"the break-away force falls with the rest in the fitting data (gain {th[1]:.3g} N): "
-                                "not a dwell effect")
+        # a gain at the fit's rounding (reporting32 d0621: -4.9e-18 N, identical readings) is none
+        flat = abs(th[1]) <= 1e-9 * max(abs(lo), float(np.max(np.abs(e))), 1e-300)
+        how = "does not change with the rest" if flat else f"falls with the rest in the fitting data (gain {th[1]:.3g} N)"
+        return dict(out, reason=f"the break-away force {how}: not a dwell effect")
     base = model.dwell or Dwell(0.0, 0.0, tau)
     ext = model.replace(dwell=Dwell(base.level + float(th[0]), base.gain + float(th[1]), tau, base.sliding))
     ev0, ev1 = (e, _left_out(t, e, lo)) if pooled else (ev, excess(ext, tv, Fv, sv))
