@@ -107,3 +107,17 @@ def test_a_swap_at_the_noise_floor_keeps_the_selected_special_case():
     assert sorted(c.name for c in d.causes) == ["cogging", "viscous"], [(c.name, c.parameters) for c in d.causes]
     b = next(e["params"]["b"] for e in truth["effects"] if e["cause"] == "viscous")
     assert next(c for c in d.causes if c.name == "viscous").parameters["b"] == pytest.approx(b, rel=0.03)
+
+
+@pytest.mark.parametrize("names, words", [
+    (("delay",), "the fitted extension is not physical: delay < 0"),
+    (("delay", "mass"), "the fitted extension is not physical beside mass: delay < 0")])
+def test_an_unphysical_member_is_said_beside_the_others_only_where_there_are_others(names, words):
+    """The reason read 'not physical beside : delay ...' for a set of one (reporting31/32)."""
+    bad = {n: Explanation(tuple((m, 0) for m in n), np.zeros(0), 0.0, 0.0,
+                          unphysical={"delay": "delay < 0"} if "delay" in n else {})
+           for n in (names, tuple(m for m in names if m != "delay"))}
+    rejected = []
+    left = force._physical_subset(_Lib({}), bad, names, rejected)
+    assert left.names == tuple(m for m in names if m != "delay")
+    assert rejected[0]["reason"] == words

@@ -169,3 +169,17 @@ def test_out_of_sample_with_few_windows_reads_student_t():
     _, t2, p_t = out_of_sample(e0, yhat, run, nm, dof=3.6)
     assert t2 == t and p_norm == pytest.approx(st.norm.sf(t)) and p_t == pytest.approx(st.t.sf(t, 3.6))
     assert p_t > p_norm
+
+
+def test_relative_changes_of_nothing_are_none_not_minus_100_percent():
+    """A noise-free record of the nominal model leaves residuals and position errors of exactly 0:
+    their relative changes were 0 / 1e-300 (reasons quoted -100.0 %, -999.0 % and -5.3e+293 %)."""
+    from hunting.diagnose import force
+    from hunting.diagnose.stats import relative_fall
+    assert relative_fall(0.0, 0.0) == 0.0
+    assert relative_fall(0.0, 1e-7) == -np.inf
+    assert relative_fall(2.0, np.inf) == -np.inf
+    assert relative_fall(2.0, 0.5) == pytest.approx(0.75)
+    assert force._shape_gain(np.zeros(8), np.ones(8)) == 0.0
+    e = np.linspace(-1.0, 1.0, 8)
+    assert force._shape_gain(e, e) > 1e6        # the shape explains it all

@@ -713,6 +713,8 @@ def _shape_gain(e: np.ndarray, y: np.ndarray) -> float:
     measured, -2 % at the fitted size along the reference, 6 % at its best multiple)."""
     yy = float(y @ y)
     b = max(float(e @ y) / yy, 0.0) if yy > 0 else 0.0
+    if _rms(e) == 0:
+        return 0.0              # nothing to explain (was -100 %: 0 over 1e-300)
     return _rms(e) / max(_rms(e - b * y), 1e-300) - 1
 
 
@@ -834,9 +836,9 @@ def _physical_subset(lib: Library, fits: dict, names: tuple, rejected: list) -> 
         if ex.physical:
             return ex
         name, why = next(iter(ex.unphysical.items()))
+        others = ", ".join(n for n in names if n != name)
         rejected.append(dict(name=name, step="validation", statistic=None, p_value=None, validation_gain=None,
-                             reason=f"the fitted extension is not physical beside {', '.join(n for n in names if n != name)}: "
-                                    f"{why}"))
+                             reason=f"the fitted extension is not physical{' beside ' + others if others else ''}: {why}"))
         names = tuple(n for n in names if n != name)
 
 

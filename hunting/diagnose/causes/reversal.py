@@ -150,7 +150,7 @@ def unphysical(theta, hyper, model) -> str | None:
     if k > RATIO_SHOWN:
         return (f"the friction change after reversals is more than {RATIO_SHOWN:g} times LuGre's at {at}, whose "
                 f"build-up (over a slip of about {_q(_slip(hyper, model), None, 'm')}) hardly shows in these data; {tail}")
-    return f"the friction change after reversals is {k:.2f} times LuGre's ({at}); {tail}"
+    return f"the friction change after reversals is {k:.2g} times LuGre's ({at}); {tail}"
 
 
 def _slip(hyper, model) -> float:
