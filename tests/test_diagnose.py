@@ -425,6 +425,22 @@ def test_no_cause_headline_gives_the_residual_not_a_model_that_explains_the_data
     assert " N RMS" in first and "of the drive force" in first
 
 
+def test_no_cause_headline_without_the_force_channel_gives_the_re_simulation_error():
+    """Where the force channel was not run (reporting32 d0621: the drive at its bound, the plant
+    barely moving), the headline said only that no cause passed; it gives the nominal model's
+    re-simulated position error beside the measured motion (19.4 mm RMS off over 27.3 mm)."""
+    from types import SimpleNamespace
+    from hunting.diagnose.report import no_cause_headline
+    t = np.linspace(0.0, 1.0, 101)
+    dg = SimpleNamespace(nominal=None, behaviour={"nominal": {"position_rms": 0.0194}},
+                         validation=Measurement(t, 0.0273 * t, np.zeros(101)))
+    assert no_cause_headline(dg) == ("no cause found: no cause passed the rule (the force channel was not run); the "
+                                     "nominal model's re-simulated validation position is 19.4 mm RMS off (the "
+                                     "measured position spans 27.3 mm)")
+    assert no_cause_headline(SimpleNamespace(nominal=None, behaviour=None, validation=None)) == (
+        "no cause could be tested on these data")
+
+
 def test_validating_on_the_fitting_data_is_warned_and_noted(tmp_path, capsys):
     """Review (newcomer): --validate given the fitting file (or a copy) ran the 'out-of-sample'
     test on the fitting data without a word. Now one warning line on stderr before the work, the
