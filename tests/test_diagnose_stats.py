@@ -175,7 +175,9 @@ def test_relative_changes_of_nothing_are_none_not_minus_100_percent():
     """A noise-free record of the nominal model leaves residuals and position errors of exactly 0:
     their relative changes were 0 / 1e-300 (reasons quoted -100.0 %, -999.0 % and -5.3e+293 %)."""
     from hunting.diagnose import force
-    from hunting.diagnose.stats import relative_fall
+    from hunting.diagnose.stats import relative_fall, relative_gain
+    assert relative_gain(0.0, 0.0) == 0.0 and relative_gain(1.0, 0.0) == np.inf
+    assert relative_gain(3.0, 2.0) == pytest.approx(0.5)
     assert relative_fall(0.0, 0.0) == 0.0
     assert relative_fall(0.0, 1e-7) == -np.inf
     assert relative_fall(2.0, np.inf) == -np.inf

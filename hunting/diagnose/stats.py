@@ -47,6 +47,14 @@ def relative_fall(before: float, after: float) -> float:
     return 1.0 - after / before
 
 
+def relative_gain(before: float, after: float) -> float:
+    """The validation gain before / after - 1 of an error measure, :func:`relative_fall`'s other
+    form: 0 where both are 0, inf where only ``after`` is 0 (explained exactly)."""
+    if after <= 0:
+        return 0.0 if before <= 0 else np.inf
+    return before / after - 1.0
+
+
 @dataclass(frozen=True)
 class Samples:
     """The thinned samples of one record: idx (m,) indices into the record's arrays, run (m,)
