@@ -27,7 +27,10 @@ A set in which a member's own force change exceeds ``CANCEL`` times the drive fo
 physical (:meth:`Library.cancelling`): collinear signatures fitted against each other cancel to
 a small residual with absurd parameters.
 
-Acceptance (validation data): each member c of the best set must (1) explain the validation
+Acceptance (validation data): where the BIC-best set is no cause, the BIC-best set with one is
+judged instead, once (where it fails, no cause: a fitting record that barely shows an effect pays
+the penalty of its coefficients without their gain). Each member c of the judged set must (1)
+explain the validation
 residual of the set without c out of sample, p < alpha (:func:`stats.out_of_sample`), and (2)
 grow the validation RMS by at least ``min_gain`` (relative) when dropped, and by more than
 ``PRECISION`` of the drive force's RMS (absolute: a model that reproduces the data to numerical
