@@ -194,7 +194,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its "
                                 f"extreme{where})")
     elif abs(sat - U) <= 0.01 * U:
-        return dict(out, reason=f"the model already saturates at {sat:.4g}")
+        return dict(out, reason=f"the model's controller output already saturates at {sat:.4g} (in u's units), the "
+                                f"bound the records pile up at ({U:.4g})")
     if not can_sim:
         return dict(out, reason="the gain needs re-simulation: the model's controller and the reference q_ref", untestable=True)
     ext = model.replace(controller=dict(model.controller, saturation=U))
