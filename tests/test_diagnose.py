@@ -439,6 +439,8 @@ def test_no_cause_headline_without_the_force_channel_gives_the_re_simulation_err
                                      "measured position spans 27.3 mm)")
     assert no_cause_headline(SimpleNamespace(nominal=None, behaviour=None, validation=None)) == (
         "no cause could be tested on these data")
+    dg.behaviour["nominal"]["ok"] = False          # a re-simulation that stopped: no error over part of it
+    assert no_cause_headline(dg).endswith("the nominal model's re-simulation of the validation record fails")
 
 
 def test_validating_on_the_fitting_data_is_warned_and_noted(tmp_path, capsys):

@@ -171,7 +171,7 @@ def test_out_of_sample_with_few_windows_reads_student_t():
     assert p_t > p_norm
 
 
-def test_relative_changes_of_nothing_are_none_not_minus_100_percent():
+def test_relative_changes_of_nothing_are_zero_and_of_a_failed_run_minus_inf():
     """A noise-free record of the nominal model leaves residuals and position errors of exactly 0:
     their relative changes were 0 / 1e-300 (reasons quoted -100.0 %, -999.0 % and -5.3e+293 %)."""
     from hunting.diagnose import force
@@ -181,6 +181,8 @@ def test_relative_changes_of_nothing_are_none_not_minus_100_percent():
     assert relative_fall(0.0, 0.0) == 0.0
     assert relative_fall(0.0, 1e-7) == -np.inf
     assert relative_fall(2.0, np.inf) == -np.inf
+    assert relative_fall(np.inf, 1.0) == -np.inf and relative_fall(np.nan, 1.0) == -np.inf
+    assert relative_gain(np.inf, 1.0) == -1.0
     assert relative_fall(2.0, 0.5) == pytest.approx(0.75)
     assert force._shape_gain(np.zeros(8), np.ones(8)) == 0.0
     e = np.linspace(-1.0, 1.0, 8)

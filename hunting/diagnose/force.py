@@ -27,9 +27,10 @@ A set in which a member's own force change exceeds ``CANCEL`` times the drive fo
 physical (:meth:`Library.cancelling`): collinear signatures fitted against each other cancel to
 a small residual with absurd parameters.
 
-Acceptance (validation data): where the BIC-best set is no cause, the BIC-best set with one is
-judged instead, once (where it fails, no cause: a fitting record that barely shows an effect pays
-the penalty of its coefficients without their gain). Each member c of the judged set must (1)
+Acceptance (validation data): where the BIC-best set is no cause, the BIC-best set with any cause
+is judged instead, once (where it fails, no cause, and none of its causes is handed on to the
+loop channel: a fitting record that barely shows an effect pays the penalty of its coefficients
+without their gain). Each member c of the judged set must (1)
 explain the validation
 residual of the set without c out of sample, p < alpha (:func:`stats.out_of_sample`), and (2)
 grow the validation RMS by at least ``min_gain`` (relative) when dropped, and by more than
@@ -510,8 +511,8 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
         e_full = lib.rv[Sv.idx]
     noise_v = NoiseModel.fit(e_full, Sv.run)
     current = ranking[0]
-    # where the fitting data's BIC prefers no cause, the best set with one is judged all the same
-    # (once: where it fails, no cause): a fitting record that barely shows an effect the
+    # where the fitting data's BIC prefers no cause, the BIC-best set with any is judged all the
+    # same (once: where it fails, no cause, and the loop channel is not asked): a fitting record that barely shows an effect the
     # validation record shows plainly pays the penalty without the gain (independent seed-4 d0045:
     # a Stribeck bump at vs = 0.6 mm/s, a fitting record at 85 mm/s, BIC +5.5, the validation
     # residual -78 %), and a set that is not the BIC-best but holds is judged the same way
@@ -530,7 +531,9 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
                                  p_value=tests[worst]["p_value"], validation_gain=tests[worst]["gain"],
                                  reason=_why(tests[worst], alpha, min_gain, alpha_reference),
-                                 reference_only=reference_only(tests[worst], alpha, min_gain, alpha_reference)))
+                                 # a probed cause is judged once: not handed on to the loop channel
+                                 reference_only=not probe and reference_only(tests[worst], alpha, min_gain,
+                                                                             alpha_reference)))
             dropped.add(worst)
             current = _physical_subset(lib, fits, tuple(n for n in current.names if n != worst), rejected)
             if not current.names and probe:
@@ -597,6 +600,8 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             # a noise-free record of the nominal model itself: no relative change to quote
             on_val = (f"the nominal model's validation residual ({rms0:.3g} N RMS) is at numerical precision "
                       f"(with it {rms_alone:.3g} N RMS)")
+        elif gain < -9.0:
+            on_val = f"makes the validation residual {rms_alone:.3g} N RMS against {rms0:.3g} without it"
         else:
             on_val = f"the validation residual by {-gain:+.1%}"
         last[name] = dict(name=name, step="search", statistic=None, p_value=None,
@@ -864,7 +869,12 @@ def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) 
         out.append(f"its prediction along the reference trajectory does not explain the validation data "
                    f"(p = {t['p_reference']:.2g} >= {alpha_reference:g}): the loop's reaction to its own noise")
     if t["gain"] < min_gain:
-        out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
+        if t["rms_without"] <= 0 or t["gain"] < -0.9:
+            # nothing left without it, or more than tenfold worse with it: a percentage misleads
+            out.append(f"with it the validation residual is {t['rms']:.3g} N RMS against {t['rms_without']:.3g} "
+                       "without it")
+        else:
+            out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
     least = REFERENCE_GAIN * min_gain
     if t.get("p_reference", 0.0) < alpha_reference:         # otherwise its reason above says so
         if t.get("gain_reference", np.inf) < least:

@@ -139,10 +139,13 @@ def no_cause_headline(dg: Diagnosis) -> str:
             return "no cause could be tested on these data"
         # the size of what is unexplained, from the re-simulation (reporting32 d0621: the drive at its
         # bound, the plant barely moving, 19.4 mm of error on 27 mm of motion read as "no cause found")
-        err = dg.behaviour["nominal"].get("position_rms")
+        nominal = dg.behaviour["nominal"]
+        err = nominal.get("position_rms")
         q = dg.validation.q if dg.validation is not None else None
         size = ""
-        if err is not None and np.isfinite(err) and q is not None:
+        if nominal.get("ok") is False:
+            size = "; the nominal model's re-simulation of the validation record fails"
+        elif err is not None and np.isfinite(err) and q is not None:
             size = (f"; the nominal model's re-simulated validation position is {_q(err, None, 'm')} RMS off "
                     f"(the measured position spans {_q(float(np.ptp(q)), None, 'm')})")
         return f"no cause found: no cause passed the rule (the force channel was not run){size}"

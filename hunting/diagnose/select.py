@@ -73,7 +73,7 @@ from .model import NominalModel
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
         "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once (where "
-        "that is no cause, the best set with one, judged once); each "
+        "that is no cause, the best set with any, judged once); each "
         "of its causes kept when it explains the validation residual of the others out of sample (one-sided test, "
         "prewhitened, autocorrelation-consistent standard error, Student's t with the validation data's filter windows less one as degrees of freedom, p < {alpha:g}; with a moving reference its prediction "
         "along the reference too, p < {alpha_reference:g}, and, with a controller in the model, that prediction's shape, alone and with "
@@ -969,21 +969,18 @@ def _own_failure(v: dict, alpha: float, min_gain: float) -> str | None:
 
 
 def _gain_words(before: float, after: float, min_gain: float, metric: str) -> str:
-    """Why a validation ``metric`` (its name with the unit in brackets) that went from ``before``
-    to ``after`` does not admit a cause: its relative fall below ``min_gain``, or, where that
-    means nothing, what happened."""
+    """Why a validation ``metric`` (its name with the unit in brackets, and what it is taken
+    over) that went from ``before`` to ``after`` does not admit a cause: its relative fall below
+    ``min_gain``, or, where that means nothing, both values with the metric in full."""
     from .causes._words import _q
+    if not np.isfinite(before):
+        return "the nominal model does not re-simulate the validation record: no gain to judge"
     if not np.isfinite(after):
         return "the extension does not re-simulate the validation record"
     unit = metric.split("[")[-1].split("]")[0] if "[" in metric else ""
-    name = metric.split(" [")[0]
-    if before <= 0:
-        return (f"the nominal model reproduces the validation record exactly ({name} 0 {unit}; "
-                f"{_q(after, None, unit)} with the extension)")
     gain = relative_fall(before, after)
-    if gain < -9.0:             # a percentage of thousands reads as noise: the two values
-        return (f"the extension makes the validation record's {name} {_q(after, None, unit)} against "
-                f"{_q(before, None, unit)} without it")
+    if before <= 0 or gain < -9.0:   # nothing to explain, or a percentage of thousands: the two values
+        return f"{metric}: {_q(after, None, unit)} with the extension against {_q(before, None, unit)} without it"
     return f"validation gain {gain:.1%} < {min_gain:.0%}"
 
 

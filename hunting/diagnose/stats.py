@@ -38,9 +38,9 @@ IV_LAGS = 40        # lags of the instrumented estimate's covariance (an unwhite
 def relative_fall(before: float, after: float) -> float:
     """The relative fall 1 - after / before of an error measure (a validation residual's RMS, a
     re-simulated position error): 0 where both are 0 (nothing to explain and nothing added: a
-    noise-free record of the nominal model itself), -inf where only ``before`` is 0 or ``after``
-    is not finite (a re-simulation that failed)."""
-    if not np.isfinite(after):
+    noise-free record of the nominal model itself), -inf where only ``before`` is 0 or either is
+    not finite (a re-simulation that failed: no gain can be claimed against it)."""
+    if not (np.isfinite(before) and np.isfinite(after)):
         return -np.inf
     if before <= 0:
         return 0.0 if after <= 0 else -np.inf
@@ -49,7 +49,10 @@ def relative_fall(before: float, after: float) -> float:
 
 def relative_gain(before: float, after: float) -> float:
     """The validation gain before / after - 1 of an error measure, :func:`relative_fall`'s other
-    form: 0 where both are 0, inf where only ``after`` is 0 (explained exactly)."""
+    form: 0 where both are 0, inf where only ``after`` is 0 (explained exactly), -1 where either
+    is not finite."""
+    if not (np.isfinite(before) and np.isfinite(after)):
+        return -1.0
     if after <= 0:
         return 0.0 if before <= 0 else np.inf
     return before / after - 1.0

@@ -199,8 +199,7 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
     from ..resimulate import position_rms_error
     f0, f1 = loop["fit"]
     if loop["model"].dwell is None:       # nothing fitted (no static friction to grow from, or no re-simulation)
-        v0 = position_rms_error(val_meas, model)
-        v0 = float(v0) if np.isfinite(v0) else 0.0
+        v0 = float(position_rms_error(val_meas, model))      # inf where the nominal loop does not re-simulate
         return dict(statistic=None, p_value=None, significant=False,
                     evidence="no growth could be fitted on the fitting record's loop (no static friction in the model, "
                              "or the loop does not re-simulate)",
