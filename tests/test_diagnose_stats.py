@@ -181,8 +181,9 @@ def test_relative_changes_of_nothing_are_zero_and_of_a_failed_run_minus_inf():
     assert relative_fall(0.0, 0.0) == 0.0
     assert relative_fall(0.0, 1e-7) == -np.inf
     assert relative_fall(2.0, np.inf) == -np.inf
-    assert relative_fall(np.inf, 1.0) == -np.inf and relative_fall(np.nan, 1.0) == -np.inf
-    assert relative_gain(np.inf, 1.0) == -1.0
+    assert relative_fall(np.inf, 1.0) == 1.0 and relative_fall(np.inf, np.inf) == -np.inf
+    assert relative_fall(np.nan, 1.0) == -np.inf and relative_fall(1.0, np.nan) == -np.inf
+    assert relative_gain(np.inf, 1.0) == np.inf and relative_gain(1.0, np.inf) == -1.0
     assert relative_fall(2.0, 0.5) == pytest.approx(0.75)
     assert force._shape_gain(np.zeros(8), np.ones(8)) == 0.0
     e = np.linspace(-1.0, 1.0, 8)

@@ -38,10 +38,14 @@ IV_LAGS = 40        # lags of the instrumented estimate's covariance (an unwhite
 def relative_fall(before: float, after: float) -> float:
     """The relative fall 1 - after / before of an error measure (a validation residual's RMS, a
     re-simulated position error): 0 where both are 0 (nothing to explain and nothing added: a
-    noise-free record of the nominal model itself), -inf where only ``before`` is 0 or either is
-    not finite (a re-simulation that failed: no gain can be claimed against it)."""
-    if not (np.isfinite(before) and np.isfinite(after)):
+    noise-free record of the nominal model itself), -inf where only ``before`` is 0 or ``after``
+    is not finite (an extension whose re-simulation failed) or either is NaN, 1 where only
+    ``before`` is infinite (the limit: an extension that re-simulates a record the nominal model
+    fails on removes all of an unbounded error)."""
+    if np.isnan(before) or not np.isfinite(after):
         return -np.inf
+    if np.isinf(before):
+        return 1.0
     if before <= 0:
         return 0.0 if after <= 0 else -np.inf
     return 1.0 - after / before
@@ -49,10 +53,12 @@ def relative_fall(before: float, after: float) -> float:
 
 def relative_gain(before: float, after: float) -> float:
     """The validation gain before / after - 1 of an error measure, :func:`relative_fall`'s other
-    form: 0 where both are 0, inf where only ``after`` is 0 (explained exactly), -1 where either
-    is not finite."""
-    if not (np.isfinite(before) and np.isfinite(after)):
+    form: 0 where both are 0, inf where only ``after`` is 0 (explained exactly) or only
+    ``before`` is infinite, -1 where ``after`` is not finite or either is NaN."""
+    if np.isnan(before) or not np.isfinite(after):
         return -1.0
+    if np.isinf(before):
+        return np.inf
     if after <= 0:
         return 0.0 if before <= 0 else np.inf
     return before / after - 1.0
