@@ -294,6 +294,27 @@ def test_bad_input_gets_one_clear_error(tmp_path):
         NominalModel.from_dict({"plant": {"mass": 1, "masss": 2}, "friction": {"Fc": 1}})
 
 
+@pytest.mark.parametrize("moving, raises", [(20, False), (200, True)])
+def test_units_are_judged_on_enough_sliding_samples(moving, raises):
+    """A record that only creeps (independent seed-5 d0078, LuGre presliding: 20 samples at
+    30-90 um/s just over the stick speed, the drive near zero) is no units disagreement; 200
+    such samples with the model's friction 100 times the drive are."""
+    from types import SimpleNamespace
+    from hunting.diagnose.guards import MIN_UNIT_SAMPLES, check_units
+    assert MIN_UNIT_SAMPLES == 100
+    n = 1000
+    mask = np.zeros(n, bool)
+    mask[:moving] = True
+    kin = SimpleNamespace(moving=mask, force=np.full(n, 0.01), a=np.zeros(n), v=np.full(n, 5e-5),
+                          t=np.arange(n) * 1e-3)
+    nominal = true_model(TruePlant())
+    if raises:
+        with pytest.raises(SystemDefinitionError, match="disagree in their units"):
+            check_units(kin, nominal, "val.npz")
+    else:
+        assert check_units(kin, nominal, "val.npz") is None
+
+
 def test_short_record_lists_what_it_cannot_test():
     """A 2 s record: what it is too short for is listed as not tested with the reason, never a
     silent empty report."""
