@@ -94,23 +94,3 @@ def test_a_noise_free_clean_record_gets_reasons_in_words_not_relative_changes_of
     assert "makes its re-simulated position error" in reasons["dwell"] and "against 0 m without" in reasons["dwell"]
     json.dumps(dg.as_dict(), allow_nan=False)
 
-
-@pytest.fixture(scope="module")
-def seed4_stribeck(tmp_path_factory):
-    out = tmp_path_factory.mktemp("independent4")
-    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(out), "--seed", "4",
-                    "--only", "45"], check=True, capture_output=True)
-    return out
-
-
-def test_an_effect_the_fitting_record_barely_shows_is_judged_though_bic_prefers_no_cause(seed4_stribeck):
-    """Seed-4 d0045: a Stribeck bump at vs = 0.6 mm/s, a fitting record at 85 mm/s (sine and
-    triangle) and a validation record at 3.8 mm/s. The fitting data's BIC ranks no cause first
-    ({stribeck} +5.5: the penalty without the gain), and nothing was judged; the BIC-best set
-    with a cause is now judged once on the validation data: stribeck, Fs within 10 %."""
-    truth, dg = _diagnosis(seed4_stribeck, 45)
-    assert truth["causes"] == ["stribeck"]
-    assert [c.name for c in dg.causes] == ["stribeck"]
-    assert dg.causes[0].parameters["Fs"] == pytest.approx(truth["params"]["Fs"], rel=0.1)
-    nominal = [e for e in dg.explanations if not e["causes"]]
-    assert nominal and nominal[0]["bic_difference"] < 0      # the fitting data alone prefer no cause

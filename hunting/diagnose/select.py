@@ -72,8 +72,7 @@ from .stats import relative_fall
 from .model import NominalModel
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
-        "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once (where "
-        "that is no cause, the best set with any, judged once); each "
+        "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once; each "
         "of its causes kept when it explains the validation residual of the others out of sample (one-sided test, "
         "prewhitened, autocorrelation-consistent standard error, Student's t with the validation data's filter windows less one as degrees of freedom, p < {alpha:g}; with a moving reference its prediction "
         "along the reference too, p < {alpha_reference:g}, and, with a controller in the model, that prediction's shape, alone and with "
