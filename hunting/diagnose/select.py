@@ -68,8 +68,8 @@ from .causes import CAUSES, untestable
 from .data import Measurement
 from .kinematics import Kinematics, kinematics, reference_kinematics, used_samples
 from .loop_sigma import parameter_sigma
-from .stats import relative_fall
 from .model import NominalModel
+from .stats import relative_fall
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
         "residual, thinned and prewhitened by an AR noise model of the residual left by every candidate at once; each "
