@@ -188,3 +188,11 @@ def test_relative_changes_of_nothing_are_zero_and_of_a_failed_run_minus_inf():
     assert force._shape_gain(np.zeros(8), np.ones(8)) == 0.0
     e = np.linspace(-1.0, 1.0, 8)
     assert force._shape_gain(e, e) > 1e6        # the shape explains it all
+
+
+def test_a_share_just_below_its_bar_does_not_read_as_the_bar():
+    """'explain 5.0% ... (at least 5% needed)' for a share of 0.04996 (reporting31 reasons)."""
+    from hunting.diagnose.causes._words import pct_against
+    assert pct_against(0.04996, 0.05) == "4.996%"
+    assert pct_against(0.048, 0.05) == "4.8%" and pct_against(-0.3, 0.05) == "-30.0%"
+    assert pct_against(0.05, 0.05) == "5.0%"

@@ -61,6 +61,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .causes import CAUSES, hyper_count, hyper_keys, untestable
+from .causes._words import pct_against
 from .kinematics import Kinematics, residual
 from .model import NominalModel
 from .stats import NoiseModel, Samples, out_of_sample, relative_fall, relative_gain
@@ -861,7 +862,7 @@ def _why(t: dict, alpha: float, min_gain: float, alpha_reference: float = 0.01) 
             out.append(f"with it the validation residual is {t['rms']:.3g} N RMS against {t['rms_without']:.3g} "
                        "without it")
         else:
-            out.append(f"validation gain {t['gain']:.1%} < {min_gain:.0%}")
+            out.append(f"validation gain {pct_against(t['gain'], min_gain)} < {min_gain:.0%}")
     least = REFERENCE_GAIN * min_gain
     if t.get("p_reference", 0.0) < alpha_reference:         # otherwise its reason above says so
         if t.get("gain_reference", np.inf) < least:

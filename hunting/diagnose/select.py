@@ -971,7 +971,7 @@ def _gain_words(before: float, after: float, min_gain: float, metric: str) -> st
     """Why a validation ``metric`` (its name with the unit in brackets, and what it is taken
     over) that went from ``before`` to ``after`` does not admit a cause: its relative fall below
     ``min_gain``, or, where that means nothing, both values with the metric in full."""
-    from .causes._words import _q
+    from .causes._words import _q, pct_against
     if not np.isfinite(before):
         return "the nominal model does not re-simulate the validation record: no gain to judge"
     if not np.isfinite(after):
@@ -980,7 +980,7 @@ def _gain_words(before: float, after: float, min_gain: float, metric: str) -> st
     gain = relative_fall(before, after)
     if before <= 0 or gain < -9.0:   # nothing to explain, or a percentage of thousands: the two values
         return f"{metric}: {_q(after, None, unit)} with the extension against {_q(before, None, unit)} without it"
-    return f"validation gain {gain:.1%} < {min_gain:.0%}"
+    return f"validation gain {pct_against(gain, min_gain)} < {min_gain:.0%}"
 
 
 def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):

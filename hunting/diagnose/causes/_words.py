@@ -64,3 +64,14 @@ def cut_words(before: float, after: float, what: str, plural: bool = False) -> s
         return (f"{'make' if plural else 'makes'} {what} {_q(after, None, 'm')} against {_q(before, None, 'm')} "
                 f"without {'them' if plural else 'it'}")
     return f"{'cut' if plural else 'cuts'} {what} by {gain:.1%}"
+
+
+def pct_against(x: float, bar: float) -> str:
+    """``x`` as a percentage with one decimal, or as many more (up to six) as it takes not to
+    read as ``bar`` itself: a share of 0.04996 against a bar of 5 % is '4.996%', not '5.0%'
+    beside '5% needed'."""
+    for digits in range(1, 7):
+        text = f"{x:.{digits}%}"
+        if x == bar or float(text[:-1]) / 100 != round(bar, digits + 2):
+            return text
+    return f"{x:.6%}"

@@ -35,7 +35,7 @@ from scipy.signal import savgol_filter
 
 from ..loop_sigma import coefficient_sigma, two_records
 from ..stats import relative_fall
-from ._words import _q, cut_words
+from ._words import _q, cut_words, pct_against
 
 NAME = "presliding"
 DESCRIPTION = "finite stick stiffness: motion while |F| < Fs (LuGre sigma0)"
@@ -141,8 +141,8 @@ def not_following(kin, model, segs) -> str | None:
         return ("the motion where the model sticks goes against the force changes (a negative compliance): slow "
                 "sliding or slips, not bristles that creep with the force they carry")
     if share < MIN_FOLLOWING:
-        return (f"the force changes explain {share:.1%} of the motion where the model sticks (LuGre's creep follows "
-                f"them; at least {MIN_FOLLOWING:.0%} needed): slow sliding or slips, not presliding")
+        return (f"the force changes explain {pct_against(share, MIN_FOLLOWING)} of the motion where the model sticks "
+                f"(LuGre's creep follows them; at least {MIN_FOLLOWING:.0%} needed): slow sliding or slips, not presliding")
     return None
 
 
