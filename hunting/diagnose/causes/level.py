@@ -55,7 +55,7 @@ def untestable(kin, model, validation: bool = False) -> str | None:
     return None
 
 
-def _levels(v, model) -> np.ndarray:
+def signed_levels(v, model) -> np.ndarray:
     """sign(v) g(|v|) [N] (n,): the nominal Stribeck level of the direction of each velocity."""
     pos, neg = model.curve.positive, model.curve.negative
     out = np.zeros_like(v)
@@ -66,7 +66,7 @@ def _levels(v, model) -> np.ndarray:
 
 
 def design(kin, model, hyper):
-    return kin.sliding(_levels(kin.vf, model))[:, None]
+    return kin.sliding(signed_levels(kin.vf, model))[:, None]
 
 
 def unphysical(theta, hyper, model) -> str | None:

@@ -70,9 +70,9 @@ def untestable(kin, model, validation: bool = False) -> str | None:
 
 def design(kin, model, hyper):
     """(n, 2) [N]: the nominal level g+(|v|) on the positive velocities, -g-(|v|) on the negative."""
-    from .level import _levels
+    from .level import signed_levels
     v = kin.vf
-    g = _levels(v, model)
+    g = signed_levels(v, model)
     return kin.sliding(np.column_stack([np.where(v > 0, g, 0.0), np.where(v < 0, g, 0.0)]))
 
 
