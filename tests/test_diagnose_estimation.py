@@ -552,6 +552,30 @@ def test_a_cause_fitted_on_the_validation_record_holds_beside_the_causes_found_b
     assert any(r["name"] == "asymmetry" and "alternate blocks" in r["reason"] for r in d.rejected), d.rejected
 
 
+def test_causes_found_beside_a_validation_only_cause_are_refitted_with_it():
+    """reporting33 d0413: a Coulomb asymmetry (an offset of 8.11 N while sliding) with a viscous
+    one (b+ 709.5, b- 268.3 for a nominal 488.9 N s/m); the fitting record slides one way only.
+    There the offset took up the viscous change times the speed (11.3 N, 39 % high) and the
+    asymmetry, fitted on top of it on the validation record's blocks, came out 561 / 431 N s/m.
+    Fitted together on those blocks: every value within 2 % of the truth, and the extended
+    model holds the values reported."""
+    fit, val, model, truth = _dataset("reporting33", 413)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["offset", "asymmetry"], [(c.name, c.parameters) for c in d.causes]
+    true = truth["effects"][0]["params"]
+    got = {k: v for c in d.causes for k, v in c.parameters.items()}
+    for key in ("offset", "b_pos", "b_neg"):
+        assert got[key] == pytest.approx(true[key], rel=0.02), (key, got[key], true[key])
+    ext = d.extended_model
+    assert ext.offset == pytest.approx(got["offset"], rel=1e-9)
+    assert (ext.curve.positive.b, ext.curve.negative.b) == pytest.approx((got["b_pos"], got["b_neg"]), rel=1e-9)
+    # every value comes with an uncertainty that covers the truth
+    for c in d.causes:
+        for key, s in c.sigma.items():
+            assert s > 0 and abs(c.parameters[key] - true[key]) < 3 * s, (key, c.parameters[key], s, true[key])
+    assert d.extended < 0.5 * d.nominal, (d.nominal, d.extended)
+
+
 def test_dwell_with_few_fitting_rests_is_judged_over_both_records():
     """reporting10 d0436: a dwell growth of 0.047 N (time 37 ms) with 4 rests ending in motion in
     the fitting record (5 needed to fit three parameters) and 9 in the validation record: left
