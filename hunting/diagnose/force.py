@@ -544,7 +544,9 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                     beaten.append((len(sub), -alt.bic, sub, rms_sub, alt))
         if not beaten:
             swap = (_general_case(lib, fits, current, rms_full, rms0, min_gain, dropped)
-                    or _special_case(lib, fits, current, rms_full, min_gain, dropped))
+                    or _special_case(lib, fits, current, rms_full, rms0, min_gain, dropped,
+                                     lambda alt: not any(_fails(t, alpha, min_gain, alpha_reference)
+                                                         for t in _tests(lib, alt, noise_v, floor)[0].values())))
             if swap is None:
                 rival = _rival(lib, ranking, current, rms_full, rms0, noise_v, floor, min_gain, alpha, alpha_reference,
                                dropped)
@@ -771,26 +773,39 @@ def _general_case(lib: Library, fits: dict, current: Explanation, rms_full: floa
     return None
 
 
-def _special_case(lib: Library, fits: dict, current: Explanation, rms_full: float, min_gain: float, dropped: set):
+def _special_case(lib: Library, fits: dict, current: Explanation, rms_full: float, rms0: float, min_gain: float,
+                  dropped: set, holds=lambda alt: True):
     """(general, explanation, reason) when a member of ``current`` has a special case (its ``NESTS``: a
     viscous change is a direction-dependent one with b+ and b- moved alike) and the set with the
     special case in its place, at its best variant, explains the validation data as well, the
     general one not better by min_gain: the fitting data's BIC can favour the general case on
     noise alone, and an engineer names the specific effect unless the extra freedom is needed.
-    None otherwise. The two rules never both fire on one pair; between them, where the general
+    None otherwise. The two rules never both fire on one pair. Between them, where the general
     case is better by min_gain of what is left but not by SWAP_SHARE of the nominal residual
-    (both at the noise), neither fires and the fitting data's choice stands (a swap to a special
-    case min_gain worse lost true asymmetries whose viscous change then failed: reporting14
-    d0497, reporting15 d0579)."""
+    (both at the noise), the fitting data decide between the two sets by BIC, and the special
+    case, where it wins, is named only when each of its set's causes holds on the validation
+    data (``holds(explanation)``): a swap to a special case min_gain worse, regardless of the
+    fitting data, lost true asymmetries whose viscous change then failed (reporting14 d0497,
+    reporting15 d0579), and without the comparison the general case stood where it was only what
+    the search's pruning of a larger set left (reporting33 d0341: a level change of 21.9 % in
+    both directions named as levels scaled apart, by 1.2188 and 1.2192; both explain 99.6 % of
+    the validation residual, and the fitting data prefer the single scale by 1.9 in BIC)."""
     for name in current.names:
         for special in getattr(CAUSES[name], "NESTS", ()):
             if special in dropped or special not in lib.variants:
                 continue
             alt, rms = _in_place(lib, fits, current, name, special)
-            if alt is not None and rms_full >= (1 - min_gain) * rms:
+            if alt is None:
+                continue
+            if rms_full >= (1 - min_gain) * rms:
                 return name, alt, (f"its special case {special} explains the validation data as well, within "
                                    f"{min_gain:.0%} ({rms:.4g} against {rms_full:.4g} N RMS): the extra freedom is "
                                    "not needed")
+            if rms - rms_full < SWAP_SHARE * rms0 and alt.bic <= current.bic and holds(alt):
+                return name, alt, (f"its special case {special} explains the validation data as well within "
+                                   f"{SWAP_SHARE:.0%} of the nominal model's validation residual ({rms:.4g} against "
+                                   f"{rms_full:.4g} of {rms0:.4g} N RMS), the fitting data prefer it (BIC "
+                                   f"{alt.bic - current.bic:+.1f}) and it holds there: the extra freedom is not needed")
     return None
 
 
