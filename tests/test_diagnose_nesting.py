@@ -30,6 +30,23 @@ def _current(*names, bic: float = 0.0):
     return Explanation(tuple((n, 0) for n in names), np.zeros(0), bic, 0.0)
 
 
+def _diagnosed(family: str, index: int):
+    """(Diagnosis, truth) of a blind dataset, drawn by the blind generator and diagnosed without the
+    behaviour view."""
+    import sys
+    from pathlib import Path
+
+    from hunting.diagnose import Measurement, NominalModel, diagnose
+    root = str(Path(__file__).resolve().parents[1])
+    if root not in sys.path:
+        sys.path.insert(0, root)
+    from benchmarks.blind import generate
+    files, truth, _ = generate.make(family, index)
+    model = NominalModel.from_dict(files["model"])
+    fit, val = Measurement(**files["fit"], name="fit"), Measurement(**files["val"], name="val")
+    return diagnose(fit, model, val, behaviour=False), truth
+
+
 @pytest.mark.parametrize("general, special", [("asymmetry", "viscous"), ("stribeck", "level")])
 @pytest.mark.parametrize("rms_general, rms_special, rms0, expect", [
     (1.00, 1.02, 2.0, "special"),      # the general case is not 5 % better: the special case is named
@@ -113,18 +130,7 @@ def test_a_swap_at_the_noise_floor_keeps_the_selected_special_case():
     left is near the noise; an asymmetry in the viscous change's place was 5 % better on that
     remainder, 1.0 % of the nominal residual, and replaced it (the viscous change was missed).
     Under SWAP_SHARE the viscous change stays, within 3 %, beside the cogging."""
-    import sys
-    from pathlib import Path
-
-    from hunting.diagnose import Measurement, NominalModel, diagnose
-    root = str(Path(__file__).resolve().parents[1])
-    if root not in sys.path:
-        sys.path.insert(0, root)
-    from benchmarks.blind import generate
-    files, truth, _ = generate.make("reporting16", 592)
-    model = NominalModel.from_dict(files["model"])
-    fit, val = Measurement(**files["fit"], name="fit"), Measurement(**files["val"], name="val")
-    d = diagnose(fit, model, val, behaviour=False)
+    d, truth = _diagnosed("reporting16", 592)
     assert sorted(c.name for c in d.causes) == ["cogging", "viscous"], [(c.name, c.parameters) for c in d.causes]
     b = next(e["params"]["b"] for e in truth["effects"] if e["cause"] == "viscous")
     assert next(c for c in d.causes if c.name == "viscous").parameters["b"] == pytest.approx(b, rel=0.03)
@@ -134,18 +140,7 @@ def test_a_level_change_alike_in_both_directions_is_named_a_level_change():
     """reporting33 d0341 end to end: the Coulomb and static levels scaled by 1.2179 in both
     directions, a nearly noise-free record; named ``level`` (was ``level_asymmetry`` with scales
     1.2188 and 1.2192), its scale within 0.5 %."""
-    import sys
-    from pathlib import Path
-
-    from hunting.diagnose import Measurement, NominalModel, diagnose
-    root = str(Path(__file__).resolve().parents[1])
-    if root not in sys.path:
-        sys.path.insert(0, root)
-    from benchmarks.blind import generate
-    files, truth, _ = generate.make("reporting33", 341)
-    model = NominalModel.from_dict(files["model"])
-    fit, val = Measurement(**files["fit"], name="fit"), Measurement(**files["val"], name="val")
-    d = diagnose(fit, model, val, behaviour=False)
+    d, truth = _diagnosed("reporting33", 341)
     assert [c.name for c in d.causes] == ["level"], [(c.name, c.parameters) for c in d.causes]
     assert d.causes[0].parameters["scale"] == pytest.approx(truth["effects"][0]["params"]["scale"], rel=0.005)
     assert any(r["name"] == "level_asymmetry" and "special case level" in r["reason"] for r in d.rejected), d.rejected
