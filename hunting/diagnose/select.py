@@ -563,7 +563,7 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
         fc2 = _identified_force_channel(_library_builder(fit2, val2, kf2, kv2, ext, w2, alpha, None), held, ext,
                                         max_causes, alpha, min_gain, alpha_reference, [])
     kept = {c.name for c in fc2["causes"]}
-    joint = _joint_values(found + [n for n in cross if n in kept], parts, model, rule) if kept else None
+    joint = _joint_values(found, [n for n in cross if n in kept], parts, model, rule) if kept else None
     fc2["rejected"] = [r for r in judged["rejected"] if r["name"] in cross and r["name"] not in kept] + [
         r for r in fc2["rejected"] if r["name"] in cross]
     fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "
@@ -583,40 +583,51 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
                 for r in fc2["rejected"]]
     # the validation record's force residual with the causes found here too (the summary's
     # "force residual RMS" is the whole extended model's)
-    causes, model_out = list(fc["causes"]) + list(fc2["causes"]), fc2["model"]
+    causes, model_out, shadows = list(fc["causes"]) + list(fc2["causes"]), fc2["model"], []
     if joint is not None:
         values, model_out = joint
-        causes = [_with_values(c, values[c.name]) for c in causes]
+        shadows = [c for c in fc["causes"] if c.name not in values]
+        causes = [_with_values(c, values[c.name]) for c in causes if c.name in values]
         r_val_ext = fc["r_val_nom"] - _force_change(causes, kv, model)
+        rejected += [dict(name=c.name, step="refit", statistic=c.statistic, p_value=c.p_value,
+                          validation_gain=c.score, reason=SHADOW_REASON.format(
+                              val=validate.name, cross=", ".join(n for n in values if n not in found)))
+                     for c in shadows]
     else:
         r_val_ext = fc["r_val_ext"] - _force_change(fc2["causes"], kv, ext)
     extended = _rms(r_val_ext[np.isfinite(r_val_ext)]) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
     return dict(fc, causes=causes, rejected=list(fc["rejected"]) + rejected,
-                model=model_out, alternatives=list(fc["alternatives"]) + list(fc2["alternatives"]),
+                model=model_out, alternatives=[a for a in list(fc["alternatives"]) + list(fc2["alternatives"])
+                                               if a.get("replaces") not in {c.name for c in shadows}],
                 explanations=list(fc["explanations"]) + list(fc2["explanations"]), r_val_ext=r_val_ext,
                 extended=extended)
 
 
-def _joint_values(names: list, parts: tuple, model: NominalModel, rule: tuple):
-    """({cause: its force-channel Cause}, extended model): the causes ``names`` (those found on the
-    fitting record, then those only the validation record can show) fitted together from
-    ``model`` on the validation record's alternate blocks ``parts`` (:func:`_interleaved`), their
-    uncertainties widened by the other blocks' values (:mod:`~hunting.diagnose.spread`); None
-    where that fit does not keep every one of them.
+def _joint_values(found: list, cross: list, parts: tuple, model: NominalModel, rule: tuple):
+    """({cause: its force-channel Cause}, extended model): the causes ``found`` on the fitting
+    record and those only the validation record can show (``cross``, kept there) searched together
+    from ``model`` on the validation record's alternate blocks ``parts`` (:func:`_interleaved`),
+    their uncertainties widened by the other blocks' values (:mod:`~hunting.diagnose.spread`);
+    None where that search does not keep every cross cause. A found cause it does not keep is
+    left out of the dict: the validation record, which shows both, does not need it beside them.
 
-    The fitting record cannot show the others' effect and carries it in its own causes' values: a
-    one-way record reads a viscous asymmetry's 220 N s/m times the speed as part of the offset
-    (reporting33 d0413: 11.3 N for a true 8.11; fitted together on the validation record's
-    blocks, 8.15 N and b+, b- within 1.2 % of the truth)."""
+    The fitting record cannot show the cross causes' effect and carries it in its own causes'
+    values: a one-way record reads a viscous asymmetry's 220 N s/m times the speed as part of the
+    offset (reporting33 d0413: 11.3 N for a true 8.11; fitted together on the validation record's
+    blocks, 8.15 N and b+, b- within 1.2 % of the truth), or as an offset of its own (reporting34
+    d0427: 0.21 N beside b+, b- of 10.8 and 10.1 N s/m for a true viscous asymmetry of 11.3 and
+    9.7 and no offset; on the blocks the asymmetry alone, 11.30 and 9.65 N s/m)."""
     from .spread import validation_values, widen
     fit2, val2, w2, kf2, kv2 = parts
     max_causes, alpha, min_gain, alpha_reference = rule
+    names = found + cross
     joint = _identified_force_channel(_library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None), names, model,
                                       max(max_causes, len(names)), alpha, min_gain, alpha_reference, [])
-    if {c.name for c in joint["causes"]} != set(names):
+    kept = [n for n in names if n in {c.name for c in joint["causes"]}]
+    if not set(cross) <= set(kept):
         return None
     swapped = _library_builder(val2, fit2, kv2, kf2, model, w2, alpha, None)
-    causes = widen(joint["causes"], validation_values(swapped, names))
+    causes = widen(joint["causes"], validation_values(swapped, kept))
     return {c.name: c for c in causes}, joint["model"]
 
 
@@ -705,6 +716,9 @@ INTERLEAVE_WINDOWS = 8   # filter windows per block of :func:`_interleaved`
 VALIDATION_ONLY_NOTE = ("the fitting data cannot show {names} ({reasons}): searched on alternate blocks of "
                         + str(INTERLEAVE_WINDOWS) + " filter windows of the validation data ({val}), on top of the "
                         "causes found, and judged on the others")
+SHADOW_REASON = ("found on the fitting data, which cannot show {cross}; searched with it on alternate blocks of the "
+                 "validation data ({val}), which show both, it does not hold beside it: the fitting data saw {cross}'s "
+                 "effect as this cause")
 OTHER_EVIDENCE_NOTE = ("{name} is named from the {channel} cause's own evidence (its evidence line); on the sliding "
                        "samples (the force channel) it was not selected: {reason}")
 POOR_FIT_NOTE = ("the fitting data ({name}) have {n} sliding samples the force channel can use (away from stops, "
