@@ -6,9 +6,6 @@ the blind benchmark's independent generator (clean tuning-side datasets on which
 without these guards reported causes)."""
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -20,31 +17,10 @@ from hunting.diagnose.model import NominalModel
 from hunting.diagnose.select import diagnose
 from hunting.diagnose.stats import NoiseModel
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.blind import generate  # noqa: E402
+from blind_records import blind_record
 
 
-def _dataset(family: str, index: int, noise: bool = True):
-    """(fit, val, model, truth) of a blind dataset, optionally regenerated without sensor and
-    actuator noise (the same draws, multiplied by zero, so the references are the same)."""
-    if noise:
-        files, truth, _ = generate.make(family, index)
-    else:
-        orig = generate.run
-
-        def quiet(plant, ctrl, sensor, r, dt, i=None, s=None, **kw):
-            return orig(plant, ctrl, sensor, r, dt, None if i is None else 0 * i, None if s is None else 0 * s, **kw)
-        mp = pytest.MonkeyPatch()
-        mp.setattr(generate, "run", quiet)
-        try:
-            files, truth, _ = generate.make(family, index)
-        finally:
-            mp.undo()
-    model = NominalModel.from_dict(files["model"])
-    return Measurement(**files["fit"], name="fit"), Measurement(**files["val"], name="val"), model, truth
+_dataset = blind_record
 
 
 @pytest.fixture(scope="module")

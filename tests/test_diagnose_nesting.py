@@ -31,19 +31,11 @@ def _current(*names, bic: float = 0.0):
 
 
 def _diagnosed(family: str, index: int):
-    """(Diagnosis, truth) of a blind dataset, drawn by the blind generator and diagnosed without the
-    behaviour view."""
-    import sys
-    from pathlib import Path
+    """(Diagnosis, truth) of a blind dataset, diagnosed without the behaviour view."""
+    from blind_records import blind_record
 
-    from hunting.diagnose import Measurement, NominalModel, diagnose
-    root = str(Path(__file__).resolve().parents[1])
-    if root not in sys.path:
-        sys.path.insert(0, root)
-    from benchmarks.blind import generate
-    files, truth, _ = generate.make(family, index)
-    model = NominalModel.from_dict(files["model"])
-    fit, val = Measurement(**files["fit"], name="fit"), Measurement(**files["val"], name="val")
+    from hunting.diagnose import diagnose
+    fit, val, model, truth = blind_record(family, index)
     return diagnose(fit, model, val, behaviour=False), truth
 
 

@@ -443,14 +443,21 @@ class Library:
             return None
         for nm, v, theta in self._members(ex):
             if nm == name:
-                mod = CAUSES[name]
-                shift = getattr(mod, "shift", None)
-                return mod.design(kx, self.model, v.hyper) @ theta + (shift(kx, self.model, v.hyper) if shift else 0.0)
+                return member_force(name, v.hyper, theta, kx, self.model)
         raise KeyError(name)
 
     def validation_rms(self, ex: Explanation) -> float:
         r = (self.rv - self.prediction(ex, "v"))[self.used_v]
         return float(np.sqrt(np.mean(r ** 2)))
+
+
+def member_force(name: str, hyper: dict, theta: np.ndarray, kin: Kinematics, model: NominalModel) -> np.ndarray:
+    """The force change (n,) [N] of cause ``name`` at its coefficients ``theta`` and
+    hyper-parameters on a record (its Kinematics), on top of ``model``: its regressors times theta
+    plus its known, unfitted part (``shift``)."""
+    mod = CAUSES[name]
+    shift = getattr(mod, "shift", None)
+    return mod.design(kin, model, hyper) @ theta + (shift(kin, model, hyper) if shift else 0.0)
 
 
 def _rms(x) -> float:

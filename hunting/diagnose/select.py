@@ -641,11 +641,10 @@ def _with_values(cause: Cause, values: Cause) -> Cause:
 def _force_change(causes: list, kin: Kinematics, model: NominalModel) -> np.ndarray:
     """The force-channel causes' summed force change (n,) [N] on a record, each at its fitted
     coefficients and hyper-parameters on top of ``model`` (0 without causes)."""
+    from .force import member_force
     out = np.zeros(kin.t.size)
     for c in causes:
-        mod = CAUSES[c.name]
-        shift = getattr(mod, "shift", None)
-        out += mod.design(kin, model, c.hyper) @ c.theta + (shift(kin, model, c.hyper) if shift else 0.0)
+        out += member_force(c.name, c.hyper, c.theta, kin, model)
     return out
 
 
