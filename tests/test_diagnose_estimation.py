@@ -569,6 +569,65 @@ def test_a_cause_the_fitting_record_saw_in_place_of_a_validation_only_cause_is_n
     assert any(r["name"] == "offset" and "saw asymmetry's effect" in r["reason"] for r in d.rejected), d.rejected
 
 
+@pytest.mark.parametrize("index, mass_rel", [(349, 0.02), (321, 0.15)])
+def test_a_resonance_above_the_fitting_records_band_is_searched_on_the_validation_record(index, mass_rel):
+    """reporting34 d0349 (8.31 Hz, damping 0.095, 0.21 kg behind 2.1 kg) and d0321 (34.9 Hz,
+    damping 0.11, 9.3 kg): the fitting records' acceleration is the encoder's noise above 6.6 and
+    21.3 Hz, the validation records' only above 50 and 37.5 Hz. No candidate on the fitting
+    record, nothing reported before; searched on the validation record's alternate blocks (their
+    band the whole record's) and judged on the others, the resonance is named, its frequency within
+    1 %."""
+    fit, val, model, truth = _dataset("reporting34", index)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["flexibility"], ([(c.name, c.parameters) for c in d.causes], d.rejected)
+    true, got = truth["effects"][0]["params"], d.causes[0].parameters
+    assert got["frequency"] == pytest.approx(true["frequency"], rel=0.01)
+    assert got["damping"] == pytest.approx(true["damping"], rel=0.1)
+    assert got["load_mass"] == pytest.approx(true["load_mass"], rel=mass_rel)
+    assert any("a resonance above" in n and "alternate blocks" in n for n in d.notes), d.notes
+    assert d.extended_model.flexibility.frequency == pytest.approx(got["frequency"], rel=1e-9)
+    assert not any(r["name"] == "flexibility" for r in d.rejected), d.rejected
+
+
+def test_a_resonance_the_fitting_record_could_show_is_not_named_from_the_validation_record(monkeypatch):
+    """The same search (reporting34 d0349) where the fitting record's band would hold the resonance
+    found (``seen`` says so): that record showed none there, so the resonance is rejected with
+    that reason and nothing is named."""
+    from hunting.diagnose.causes import flexibility
+    monkeypatch.setattr(flexibility, "seen", lambda hyper, kf, model: "inside the fitting record's band (test)")
+    fit, val, model, _ = _dataset("reporting34", 349)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == [], [(c.name, c.parameters) for c in d.causes]
+    assert any(r["name"] == "flexibility" and r["reason"].startswith("inside the fitting record's band (test)")
+               for r in d.rejected), d.rejected
+    assert d.extended_model.flexibility is None
+
+
+def test_a_resonance_the_fitting_record_cannot_test_at_all_is_not_held_to_its_band():
+    """reporting35 d0321 (26.5 Hz, 0.33 kg): the fitting record has fewer than 512 sliding
+    samples, so flexibility is untestable there although its band reaches 200 Hz; the band check
+    (``seen``) is for a record that could test the resonance, and the validation record's
+    resonance is named (it was lost to that check in a first version of it)."""
+    fit, val, model, truth = _dataset("reporting35", 321)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["flexibility"], ([(c.name, c.parameters) for c in d.causes], d.rejected)
+    true = truth["effects"][0]["params"]
+    assert d.causes[0].parameters["frequency"] == pytest.approx(true["frequency"], rel=0.01)
+    assert d.causes[0].parameters["load_mass"] == pytest.approx(true["load_mass"], rel=0.1)
+
+
+def test_a_resonance_rejected_on_both_searches_has_one_row_with_both_reasons():
+    """reporting35 d0391 (85.4 Hz, beyond what the motion excites: a validation gain of 0): the
+    fitting record's band (43.5 Hz) and the validation record's (200 Hz) each reject it; the
+    report has one row for it saying both."""
+    fit, val, model, _ = _dataset("reporting35", 391)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert "flexibility" not in [c.name for c in d.causes]
+    rows = [r for r in d.rejected if r["name"] == "flexibility"]
+    assert len(rows) == 1, rows
+    assert "; and where only the validation record can show it: " in rows[0]["reason"], rows[0]
+
+
 def test_dwell_with_few_fitting_rests_is_judged_over_both_records():
     """reporting10 d0436: a dwell growth of 0.047 N (time 37 ms) with 4 rests ending in motion in
     the fitting record (5 needed to fit three parameters) and 9 in the validation record: left

@@ -45,7 +45,10 @@ class Kinematics:
     noise (standard deviation before quantization); held [N] : cm u as sampled (each value held
     over the interval after it), for the delayed drive; q_measured [m] : the positions as
     measured (q is smoothed over the window, which rounds a rest's corners off: rests are read
-    from these)."""
+    from these); spectrum : bool (n,) or None, the samples whose acceleration spectrum tells
+    the band a resonance can be seen in (:func:`~hunting.diagnose.causes.flexibility.band`), None
+    for ``moving`` (a record split into blocks keeps its whole record's: the sensor and the
+    motion are one)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -63,6 +66,7 @@ class Kinematics:
     resolution: float = 0.0
     noise: float = 0.0
     q_measured: np.ndarray | None = None
+    spectrum: np.ndarray | None = None
 
     @property
     def dt(self) -> float:

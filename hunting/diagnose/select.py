@@ -64,7 +64,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import SystemDefinitionError
-from .causes import CAUSES, untestable
+from .causes import CAUSES, seen, unseen, untestable
 from .data import Measurement
 from .kinematics import Kinematics, kinematics, reference_kinematics, used_samples
 from .loop_sigma import parameter_sigma
@@ -521,15 +521,21 @@ def _library_builder(fit: Measurement, validate: Measurement, kf: Kinematics, kv
 def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kinematics, kv: Kinematics,
                      sensor: dict, window: float | None, rule: tuple, untested: list, notes: list) -> dict:
     """The force channel's result with the causes only the validation record can show: those
-    ``untestable`` on the fitting record (it moves one way only, its band ends below a
-    resonance) and testable on the validation record are searched on alternate blocks of the
+    ``untestable`` on the fitting record (it moves one way only, it has no band to see a
+    resonance in) or partly ``unseen`` there (a resonance above its band: then one found where the
+    fitting record could show it is rejected, ``seen``) and testable on the validation record are searched on alternate blocks of the
     validation record (:func:`_interleaved`) and judged on the others, on top of the model the
     channel extended (reporting10 d0313 and d0327: a Coulomb level 8 % and 2 % low, the fitting
     record sliding one way, where a level is an offset, left untested). Their rows in
     ``untested`` are replaced by what that search says.
     fc is returned unchanged when there are none or the parts are not :func:`_informative`."""
     ext = fc["model"]
-    reasons = {n: untestable(n, kf, ext) for n in names}
+    found = [c.name for c in fc["causes"]]
+    blind = {n: untestable(n, kf, ext) for n in names}
+    # a cause the fitting record can test in part: only a value beyond that part is the
+    # validation record's to show (``seen``)
+    partly = {n: why for n in names if not blind[n] and n not in found and (why := unseen(n, kf, kv, ext))}
+    reasons = {n: blind[n] or partly.get(n) for n in names}
     cross = {n: r for n, r in reasons.items() if r and not untestable(n, kv, ext)}
     parts = _interleaved(validate, ext, sensor, window) if cross else None
     if parts is None:
@@ -544,7 +550,6 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
     # one-way record, which an asymmetry took up) and the cross causes' family (reporting9
     # d0348: an "asymmetry" of 54.2 and 54.6 N s/m, a viscous change, beside a delay): only a
     # cross cause this search keeps is reported
-    found = [c.name for c in fc["causes"]]
     mates = [n for n in names if n not in cross and n not in found
              and any(CAUSES[n].FAMILY == CAUSES[c].FAMILY for c in cross)]
     inner: list = []
@@ -557,17 +562,26 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
     # (level_asymmetry, untestable on a one-way fitting record, over an offset found there)
     clash = {n: [c for c in found if not compatible([n, c])] for n in held}
     held = [n for n in held if not clash[n]]
-    fc2 = dict(causes=[], model=ext, alternatives=[], explanations=[], rejected=[])
-    if held:
+    fc2, inside = dict(causes=[], model=ext, alternatives=[], explanations=[], rejected=[]), {}
+    for _ in range(len(held)):        # each pass drops at least one held cause or ends the loop
         # judged on top of the model the fitting data extended
         fc2 = _identified_force_channel(_library_builder(fit2, val2, kf2, kv2, ext, w2, alpha, None), held, ext,
                                         max_causes, alpha, min_gain, alpha_reference, [])
+        # a cross cause found where the fitting record can show it after all (a resonance inside
+        # its band) is what that record did not show
+        bad = {c.name: why for c in fc2["causes"] if c.name in partly and (why := seen(c.name, c.hyper, kf, ext))}
+        if not bad:
+            break
+        inside.update(bad)
+        held = [n for n in held if n not in bad]
+        fc2 = dict(causes=[], model=ext, alternatives=[], explanations=[], rejected=[])
     kept = {c.name for c in fc2["causes"]}
     joint = _joint_values(found, [n for n in cross if n in kept], parts, model, rule) if kept else None
     fc2["rejected"] = [r for r in judged["rejected"] if r["name"] in cross and r["name"] not in kept] + [
         r for r in fc2["rejected"] if r["name"] in cross]
     fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "
                                                           "data") for n in held if n not in kept]
+    fc2["rejected"] += [dict(name=n, step="refit", reason=why) for n, why in inside.items()]
     fc2["rejected"] += [dict(name=n, step="refit", reason=f"it cannot be combined with {', '.join(c)}, found on the "
                                                           "fitting data") for n, c in clash.items() if c]
     for c in judged["causes"]:
@@ -596,11 +610,28 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
     else:
         r_val_ext = fc["r_val_ext"] - _force_change(fc2["causes"], kv, ext)
     extended = _rms(r_val_ext[np.isfinite(r_val_ext)]) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
-    return dict(fc, causes=causes, rejected=list(fc["rejected"]) + rejected,
+    return dict(fc, causes=causes, rejected=_partly_rows(fc["rejected"], rejected, partly, kept),
                 model=model_out, alternatives=[a for a in list(fc["alternatives"]) + list(fc2["alternatives"])
                                                if a.get("replaces") not in {c.name for c in shadows}],
                 explanations=list(fc["explanations"]) + list(fc2["explanations"]), r_val_ext=r_val_ext,
                 extended=extended)
+
+
+def _partly_rows(first: list, second: list, partly: dict, kept: set) -> list:
+    """The rejected rows of the fitting record's search (``first``) and of the validation-only
+    search (``second``), one row per cause: a cause the fitting record can show in part
+    (``partly``) that the second search kept has no row; one it rejected there too has one row,
+    the first's, with both reasons."""
+    again = {r["name"]: r["reason"] for r in second if r["name"] in partly}
+    out = []
+    for r in first:
+        if r["name"] in kept:
+            continue
+        if r["name"] in again:
+            r = dict(r, reason=f"{r['reason']}; and where only the validation record can show it: {again[r['name']]}")
+        out.append(r)
+    said = {r["name"] for r in first}
+    return out + [r for r in second if not (r["name"] in partly and r["name"] in said)]
 
 
 def _joint_values(found: list, cross: list, parts: tuple, model: NominalModel, rule: tuple):
@@ -764,7 +795,7 @@ def _interleaved(record: Measurement, model: NominalModel, sensor: dict, window:
     k = kinematics(record, model.cm, window=w, **sensor)
     k = replace(k, moving=used_samples(k, model))
     even = (np.arange(k.t.size) * k.dt // (INTERLEAVE_WINDOWS * k.window)).astype(int) % 2 == 0
-    kf, kv = replace(k, moving=k.moving & even), replace(k, moving=k.moving & ~even)
+    kf, kv = (replace(k, moving=k.moving & part, spectrum=k.moving) for part in (even, ~even))
     if not (_informative(kf) and _informative(kv)):
         return None
     return record, record, w, kf, kv

@@ -79,4 +79,20 @@ def untestable(name: str, kin, model, validation: bool = False) -> str | None:
     return fn(kin, model, validation=True) if validation and getattr(mod, "ONE_WAY_VALIDATION", False) else fn(kin, model)
 
 
-__all__ = ["CAUSES", "hyper_count", "hyper_keys", "untestable"]
+def unseen(name: str, kf, kv, model) -> str | None:
+    """Why the fitting record (its Kinematics ``kf``) cannot show a part of cause ``name`` that
+    the validation record (``kv``) can (its ``unseen`` hook: e.g. a resonance above the fitting
+    record's band), or None when it can show all of it or the cause has no such hook."""
+    fn = getattr(CAUSES[name], "unseen", None)
+    return None if fn is None else fn(kf, kv, model)
+
+
+def seen(name: str, hyper: dict, kf, model) -> str | None:
+    """Why cause ``name`` at hyper-parameters ``hyper``, found where the fitting record (``kf``)
+    cannot show it all (:func:`unseen`), lies where that record can show it after all (its
+    ``seen`` hook), or None."""
+    fn = getattr(CAUSES[name], "seen", None)
+    return None if fn is None else fn(hyper, kf, model)
+
+
+__all__ = ["CAUSES", "hyper_count", "hyper_keys", "seen", "unseen", "untestable"]

@@ -120,13 +120,15 @@ def band(kin) -> tuple[float, float]:
     the sampling rate, and no higher than where the measured acceleration's spectrum falls below
     NOISE_MARGIN times the part the position sensor's noise puts there (above it the acceleration, and
     every regressor made of it, is the encoder's noise, and a "resonance" fits that noise in the
-    force residual and the validation data alike)."""
+    force residual and the validation data alike). The samples are ``kin.spectrum`` where it is
+    given (the alternate blocks of one record share its band: reporting34 d0321's validation
+    record reached 37.5 Hz, its even blocks alone 28.9 and odd ones 80.6 Hz), else the moving ones."""
     from scipy.signal import welch
     from ..kinematics import acceleration_noise_psd
     dt = kin.dt
     hi = 0.1 / dt
     if kin.resolution > 0 or kin.noise > 0:
-        m = kin.moving
+        m = kin.moving if kin.spectrum is None else kin.spectrum
         f, P = welch(np.where(m, kin.a - kin.a[m].mean(), 0.0), fs=1.0 / dt, nperseg=min(4096, kin.a.size // 4))
         P = P * kin.a.size / max(m.sum(), 1)       # the PSD of the moving samples alone
         ok = (f >= 2.0) & (P > NOISE_MARGIN * acceleration_noise_psd(kin, f))
@@ -148,6 +150,29 @@ def untestable(kin, model) -> str | None:
         return (f"above {hi:.3g} Hz the measured acceleration is the position sensor's noise: no band to see a "
                 "resonance in")
     return None
+
+
+def unseen(kf, kv, model) -> str | None:
+    """Why the fitting record (``kf``) cannot show a resonance the validation record (``kv``) can:
+    its band (:func:`band`) ends below the validation record's, by more than SCAN_BOX's frequency
+    factor (reporting34 d0321: 21.3 against 37.5 Hz, a 34.9 Hz resonance; d0349: 6.6 against 50 Hz,
+    an 8.3 Hz one; neither fitting record had a candidate, both validation records had it within
+    0.5 %)."""
+    hf, hv = band(kf)[1], band(kv)[1]
+    if hv <= SCAN_BOX[0] * hf:
+        return None
+    return (f"a resonance above {hf:.3g} Hz (the fitting record's acceleration is the position sensor's noise there; "
+            f"the validation record's reaches {hv:.3g} Hz)")
+
+
+def seen(hyper, kf, model) -> str | None:
+    """Why a resonance found on the validation record alone (:func:`unseen`) lies in the fitting
+    record's band after all, where that record showed none: its frequency at most the band's top."""
+    hf = band(kf)[1]
+    if hyper["frequency"] > hf:
+        return None
+    return (f"its resonance ({hyper['frequency']:.3g} Hz) lies in the fitting record's band (up to {hf:.3g} Hz), "
+            "where that record shows none")
 
 
 def design(kin, model, hyper):
