@@ -522,9 +522,9 @@ def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement
                      sensor: dict, window: float | None, rule: tuple, untested: list, notes: list) -> dict:
     """The force channel's result with the causes only the validation record can show: those
     ``untestable`` on the fitting record (it moves one way only, it has no band to see a
-    resonance in) or partly ``unseen`` there (a resonance above its band: then one found where the
-    fitting record could show it is rejected, ``seen``) and testable on the validation record are searched on alternate blocks of the
-    validation record (:func:`_interleaved`) and judged on the others, on top of the model the
+    resonance in) or partly ``unseen`` there (a resonance above its band: then one found where
+    the fitting record could show it is rejected, ``seen``) and testable on the validation record
+    are searched on alternate blocks of the validation record (:func:`_interleaved`) and judged on the others, on top of the model the
     channel extended (reporting10 d0313 and d0327: a Coulomb level 8 % and 2 % low, the fitting
     record sliding one way, where a level is an offset, left untested). Their rows in
     ``untested`` are replaced by what that search says.
