@@ -72,27 +72,29 @@ def untestable(name: str, kin, model, validation: bool = False) -> str | None:
     ``untestable`` hook), or None when it can or the cause has no such hook. ``validation``: the
     record only judges a fit made on another, which a cause with ``ONE_WAY_VALIDATION`` (its fit
     needs both directions of motion, its prediction either) tells its hook."""
-    mod = CAUSES[name]
-    fn = getattr(mod, "untestable", None)
-    if fn is None:
-        return None
-    return fn(kin, model, validation=True) if validation and getattr(mod, "ONE_WAY_VALIDATION", False) else fn(kin, model)
+    if validation and getattr(CAUSES[name], "ONE_WAY_VALIDATION", False):
+        return _hook(name, "untestable", kin, model, validation=True)
+    return _hook(name, "untestable", kin, model)
+
+
+def _hook(name: str, hook: str, *args, **kwargs) -> str | None:
+    """Cause ``name``'s optional reason hook called with the arguments, or None where it has none."""
+    fn = getattr(CAUSES[name], hook, None)
+    return None if fn is None else fn(*args, **kwargs)
 
 
 def unseen(name: str, kf, kv, model) -> str | None:
     """Why the fitting record (its Kinematics ``kf``) cannot show a part of cause ``name`` that
     the validation record (``kv``) can (its ``unseen`` hook: e.g. a resonance above the fitting
     record's band), or None when it can show all of it or the cause has no such hook."""
-    fn = getattr(CAUSES[name], "unseen", None)
-    return None if fn is None else fn(kf, kv, model)
+    return _hook(name, "unseen", kf, kv, model)
 
 
 def seen(name: str, hyper: dict, kf, model) -> str | None:
     """Why cause ``name`` at hyper-parameters ``hyper``, found where the fitting record (``kf``)
     cannot show it all (:func:`unseen`), lies where that record can show it after all (its
     ``seen`` hook), or None."""
-    fn = getattr(CAUSES[name], "seen", None)
-    return None if fn is None else fn(hyper, kf, model)
+    return _hook(name, "seen", hyper, kf, model)
 
 
 __all__ = ["CAUSES", "hyper_count", "hyper_keys", "seen", "unseen", "untestable"]

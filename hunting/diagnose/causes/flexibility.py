@@ -163,8 +163,8 @@ def unseen(kf, kv, model) -> str | None:
     (reporting34 d0349: 6.6 against 50 Hz, an 8.3 Hz resonance, with no candidate on the fitting
     record and found within 0.5 % on the validation record's blocks). A smaller factor is the
     band estimate's noise: at 1.2 the speed benchmark's clean pair (18.1 and 31 Hz) paid a search
-    of 3 s for nothing, and reporting34 d0321 (21.3 against 37.5 Hz, a 34.9 Hz resonance named
-    that way) was the only record of three sets it named."""
+    of 3 s for nothing; reporting34 d0321 (21.3 against 37.5 Hz, a 34.9 Hz resonance) was named
+    at 1.2 and is not at 3."""
     hf, hv = band(kf)[1], band(kv)[1]
     if hv <= UNSEEN_FACTOR * hf:
         return None
