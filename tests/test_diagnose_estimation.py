@@ -643,6 +643,46 @@ def test_a_resonance_rejected_on_both_searches_has_one_row_with_both_reasons():
     assert "; and where only the validation record can show it: " in rows[0]["reason"], rows[0]
 
 
+def test_a_pitch_longer_than_the_fitting_stroke_is_searched_on_the_validation_record():
+    """reporting36 d0588: an offset (-1.10 N) beside a cogging of 1.97 mm pitch (1.46 N); the
+    fitting record moves 0.36 mm, a fifth of a period, the validation record 17 mm. Only the
+    offset was named (0.88 N, 20 % low: the fitting record carried part of the ripple in it). The
+    pitches the fitting stroke cannot show are searched on the validation record's alternate
+    blocks and judged on the others: both are named, each value within 2 %; and a pitch the
+    fitting stroke could show (``seen``) is not named from the validation record."""
+    from hunting.diagnose.causes import cogging
+    fit, val, model, truth = _dataset("reporting36", 588)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert sorted(c.name for c in d.causes) == ["cogging", "offset"], ([(c.name, c.parameters) for c in d.causes],
+                                                                      d.rejected)
+    got = {k: v for c in d.causes for k, v in c.parameters.items()}
+    for e in truth["effects"]:
+        for key in ("offset", "pitch", "amplitude_1"):
+            if key in e["params"]:
+                assert got[key] == pytest.approx(e["params"][key], rel=0.02), (key, got[key], e["params"][key])
+    assert any("cogging: a pitch longer than" in n for n in d.notes), d.notes
+    assert d.extended_model.offset == pytest.approx(got["offset"], rel=1e-9)
+    assert [c.period for c in d.extended_model.cogging] == pytest.approx([got["pitch"]], rel=1e-9)
+
+
+def test_a_pitch_the_fitting_stroke_shows_is_not_named_from_the_validation_record(monkeypatch):
+    """cogging.seen on its own: a pitch within the fitting stroke over MIN_PERIODS is one that
+    record could show (reason), a longer one is not (None); and the search of reporting36 d0588
+    with every pitch declared seen names the offset alone, the cogging rejected with that reason."""
+    from types import SimpleNamespace
+    from hunting.diagnose.causes import cogging
+    kin = SimpleNamespace(q=np.linspace(0.0, 3e-3, 200), moving=np.ones(200, dtype=bool))
+    assert cogging.stroke(kin) == pytest.approx(3e-3)
+    assert cogging.seen({"pitch": 1.9e-3}, kin, None) is not None
+    assert cogging.seen({"pitch": 2.1e-3}, kin, None) is None
+    monkeypatch.setattr(cogging, "seen", lambda hyper, kf, model: "a pitch the fitting stroke shows (test)")
+    fit, val, model, _ = _dataset("reporting36", 588)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["offset"], [(c.name, c.parameters) for c in d.causes]
+    assert any(r["name"] == "cogging" and "a pitch the fitting stroke shows (test)" in r["reason"]
+               for r in d.rejected), d.rejected
+
+
 def test_dwell_with_few_fitting_rests_is_judged_over_both_records():
     """reporting10 d0436: a dwell growth of 0.047 N (time 37 ms) with 4 rests ending in motion in
     the fitting record (5 needed to fit three parameters) and 9 in the validation record: left

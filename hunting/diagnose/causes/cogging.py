@@ -24,6 +24,11 @@ MATCH = 0.03          # a model cogging within 3 % of the pitch is the one corre
 MIN_PERIODS = 1.5     # the longest pitch searched: the fitting stroke over this many periods
 SIDEBANDS = 1.1      # two peaks' wavenumbers this close: sidebands, their midpoint a candidate too
 GONE = 0.05           # merged amplitude below 5 % of the model's: the model's cogging is not in the data (as offset)
+# the validation record's stroke over the fitting record's above which the validation record can
+# show pitches the fitting record cannot (:func:`unseen`), as for a resonance above the fitting
+# band (flexibility.UNSEEN_FACTOR): at 2, 93 of reporting36's 636 records paid the validation-only
+# search for pitches of which the validation record holds 1.5-3 periods; at 3, 37
+UNSEEN_FACTOR = 3.0
 
 
 def matched(model, pitch: float) -> int | None:
@@ -159,6 +164,35 @@ def untestable(kin, model) -> str | None:
     if kin.moving.sum() < 50:
         return "fewer than 50 sliding samples"
     return None
+
+
+def stroke(kin) -> float:
+    """The travel of the record's moving samples [m] (0 with fewer than 50: :func:`untestable`):
+    the pitches :func:`hypers` searches end at it over MIN_PERIODS."""
+    moving = kin.moving
+    return float(np.ptp(kin.q[moving])) if moving.sum() >= 50 else 0.0
+
+
+def unseen(kf, kv, model) -> str | None:
+    """Why the fitting record (``kf``) cannot show a pitch the validation record (``kv``) can: its
+    stroke holds fewer than MIN_PERIODS periods of it, and the validation record's stroke is more
+    than UNSEEN_FACTOR times as long (reporting36 d0588: an offset beside a 1.97 mm cogging, the
+    fitting record moving 0.40 mm, the validation record 17 mm; the offset alone was named)."""
+    sf, sv = stroke(kf), stroke(kv)
+    if sv <= UNSEEN_FACTOR * sf:
+        return None
+    return (f"a pitch longer than {_q(sf / MIN_PERIODS, None, 'm')} (the fitting record moves {_q(sf, None, 'm')}, "
+            f"fewer than {MIN_PERIODS:g} periods of it; the validation record {_q(sv, None, 'm')})")
+
+
+def seen(hyper, kf, model) -> str | None:
+    """Why a pitch found on the validation record alone (:func:`unseen`) is one the fitting record
+    could show, where it showed none: at most its stroke over MIN_PERIODS."""
+    longest = stroke(kf) / MIN_PERIODS
+    if hyper["pitch"] > longest:
+        return None
+    return (f"its pitch ({_q(hyper['pitch'], None, 'm')}) is one the fitting record's stroke shows (up to "
+            f"{_q(longest, None, 'm')}), where that record shows none")
 
 
 def design(kin, model, hyper):
