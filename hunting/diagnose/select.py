@@ -59,16 +59,20 @@ re-simulated with the nominal and the extended model, compared with the measurem
 (:mod:`hunting.diagnose.behaviour`)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
 from ..errors import SystemDefinitionError
-from .causes import CAUSES, seen, unseen, untestable
+from . import validation_only
+from .causes import CAUSES
 from .data import Measurement
-from .kinematics import Kinematics, kinematics, reference_kinematics, used_samples
+from .force_channel import identified_force_channel, library_builder
+from .kinematics import Kinematics, kinematics, used_samples
 from .loop_sigma import parameter_sigma
 from .model import NominalModel
+from .parts import MIN_WINDOWS, default_window, informative, split_in_time, split_validation
+from .result import Cause, Diagnosis
 from .stats import relative_fall
 
 RULE = ("force channel: the best explanation (a set of at most {max_causes} causes) by BIC on the fitting data's force "
@@ -99,129 +103,6 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "a friction-curve cause or where that static level makes the force residual on the sliding samples of both "
         "records at least {sliding_worse:.0%} larger")
 CRITERION = RULE
-METHOD_NOTE = ("force residuals are the data's less the nominal model's own on its noise-free closed loop (the "
-               "estimation's error, where that loop tracks the measured motion: {} on the fitting data, {} on the "
-               "validation data)")
-
-
-@dataclass(frozen=True)
-class Cause:
-    """One reported cause: name; score (relative growth of the validation metric when it is
-    dropped from the extended model); statistic and p_value of the test that admitted it;
-    parameters : final values (those the extended model holds) and sigma their standard
-    uncertainties (None where not estimated); gain : the validation metric of the model without
-    and with it (metric, nominal, extended; evidence: the rule that admitted it where that is not
-    a p-value, p_value then None); increments : parameters' change against the nominal model;
-    family : causes that share a signature share it; hyper : the hyper-parameter variant; theta :
-    fitted coefficients."""
-
-    name: str
-    score: float
-    statistic: float
-    p_value: float
-    parameters: dict
-    sigma: dict
-    gain: dict
-    hyper: dict = field(default_factory=dict)
-    theta: np.ndarray | None = None
-    increments: dict = field(default_factory=dict)
-    family: str = ""
-
-    def as_dict(self) -> dict:
-        return dict(name=self.name, score=self.score, statistic=self.statistic, p_value=self.p_value,
-                    parameters=self.parameters, sigma=self.sigma, increments=self.increments, gain=self.gain,
-                    family=self.family or self.name, description=CAUSES[self.name].DESCRIPTION, role="selected")
-
-
-@dataclass
-class Diagnosis:
-    """causes : list of Cause ranked by score over all channels; nominal /
-    extended : validation force-residual RMS [N] (None when the force channel was skipped);
-    criterion : the selection rule; kin_fit, kin_val : kinematics; r_* : residuals (n,) of the
-    nominal and extended model on both sets (NaN where not used: |v| small or filter edges);
-    rejected : candidates that failed the rule (with the reason); alternatives : other readings
-    of the data (a cause of the same family that would replace a selected one, a cause that
-    explains the data alone but adds nothing once the selected ones are in, or another reading of
-    a selected cause's own evidence, kind "same evidence"), each with its parameters, validation
-    gain and BIC difference (None for "same evidence"); explanations : the runner-up sets of the
-    force channel's search with their BIC difference and validation RMS; untested : causes this
-    record cannot test, with the reason; extended_model : the nominal model with every selected
-    extension; behaviour : the behaviour view on the validation data (None without a controller
-    or a reference); notes : what was skipped and why; validation : the validation Measurement
-    used; simulations : the behaviour view's re-simulations {"nominal", "extended"}."""
-
-    causes: list
-    nominal: float | None
-    extended: float | None
-    criterion: str
-    model: NominalModel
-    kin_fit: Kinematics
-    kin_val: Kinematics
-    r_fit_nominal: np.ndarray
-    r_val_nominal: np.ndarray
-    r_val_extended: np.ndarray
-    rejected: list = field(default_factory=list)
-    alternatives: list = field(default_factory=list)
-    extended_model: NominalModel | None = None
-    behaviour: dict | None = None
-    notes: list = field(default_factory=list)
-    validation: Measurement | None = None
-    simulations: dict | None = None
-    untested: list = field(default_factory=list)
-    explanations: list = field(default_factory=list)
-
-    def gains(self) -> list:
-        """Validation metrics of the nominal against the extended model, rows {metric, unit,
-        nominal, extended} and for behaviour metrics the measured value (errors are against it):
-        force residual RMS, and from the behaviour view the re-simulation's position and
-        drive-force RMS errors, stick error, cycle amplitude and period, final error, event-map
-        contraction, whether the loop ends at rest (rows the runs do not have are left out)."""
-        out = []
-        if self.nominal is not None:
-            out.append(dict(metric="force residual RMS", unit="N", nominal=self.nominal, extended=self.extended))
-        b = self.behaviour
-        if b:
-            for key, label, unit in (("position_rms", "re-simulated position RMS error", "m"),
-                                     ("force_rms", "re-simulated drive force RMS error", "N")):
-                out.append(dict(metric=label, unit=unit, nominal=b["nominal"][key], extended=b["extended"][key]))
-            for key, label, unit in (("stick_error", "stick error RMS", "m"), ("cycle_amplitude", "cycle amplitude", "m"),
-                                     ("cycle_period", "cycle period", "s"), ("final_error", "final error", "m"),
-                                     ("map_contraction", "event map contraction |d_n+1| / |d_n|", "")):
-                m = b["measured"][key]
-                if m is None or b["nominal"].get(key) is None or b["extended"].get(key) is None:
-                    continue
-                err = [abs(b[k][key] - m) for k in ("nominal", "extended")]
-                out.append(dict(metric=f"{label}: error against the measured", unit=unit, measured=m, nominal=err[0],
-                                extended=err[1]))
-            if None not in (b["measured"].get("at_rest"), b["nominal"].get("at_rest"), b["extended"].get("at_rest")):
-                out.append(dict(metric="ends at rest", unit="", measured=b["measured"]["at_rest"],
-                                nominal=b["nominal"]["at_rest"], extended=b["extended"]["at_rest"]))
-        return out
-
-    def as_dict(self) -> dict:
-        """The diagnosis as plain data for JSON: every number finite (a value that is not, e.g. the
-        gain of an extension whose loop does not re-simulate, is None; its row's reason says why)."""
-        alts = [dict(a, score=0.0, role="alternative") for a in self.alternatives]
-        return _finite(dict(causes=[c.as_dict() for c in self.causes] + alts,
-                    gain=dict(metric="force residual RMS [N] on the validation data", nominal=self.nominal,
-                              extended=self.extended),
-                    gains=self.gains(), behaviour=self.behaviour, notes=self.notes,
-                    criterion=self.criterion, rule=self.criterion, rejected=self.rejected,
-                    alternatives=self.alternatives, explanations=self.explanations, untested=self.untested,
-                    nominal_model=self.model.to_dict(),
-                    extended_model=None if self.extended_model is None else self.extended_model.to_dict()))
-
-
-def _finite(x):
-    """``x`` (nested dicts, lists and tuples) with every float that is not finite replaced by None
-    (strict JSON has no NaN or Infinity)."""
-    if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_finite(v) for v in x]
-    if isinstance(x, (float, np.floating)) and not np.isfinite(x):
-        return None
-    return x
 
 
 def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None = None, *, causes=None,
@@ -251,7 +132,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         if fit.n < 250:
             raise SystemDefinitionError(f"{fit.name}: {fit.n} samples are too few to split into fitting and validation "
                                         "parts (need >= 250, or give validation data)")
-        fit, validate = _split(fit)
+        fit, validate = split_in_time(fit)
     for meas in (fit, validate):
         check_motion(meas, model)
     notes: list = list(check_inputs(fit, validate, model))
@@ -284,8 +165,8 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     nan_f, nan_v = np.full(kf.t.size, np.nan), np.full(kv.t.size, np.nan)
     kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
     split = None
-    if force_names and not same and not _informative(kf) and _informative(kv):
-        parts = split = _split_validation(validate, model, sensor, window if window_given else None)
+    if force_names and not same and not informative(kf) and informative(kv):
+        parts = split = split_validation(validate, model, sensor, window if window_given else None)
         if parts is not None:
             notes.append(POOR_FIT_NOTE.format(name=fit.name, n=int(kf.moving.sum()), val=validate.name,
                                               windows=kf.moving.sum() * kf.dt / kf.window))
@@ -309,16 +190,16 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             own_names.remove(name)
     tick("force channel")
     windows = min(k.moving.sum() * k.dt / k.window for k in (kf, kv))
-    if force_names and _informative(kf) and _informative(kv):
-        fc = _identified_force_channel(_library_builder(fit, validate, kf, kv, model, window, alpha, notes),
+    if force_names and informative(kf) and informative(kv):
+        fc = identified_force_channel(library_builder(fit, validate, kf, kv, model, window, alpha, notes),
                                        force_names, model, max_causes, alpha, min_gain, alpha_reference, untested)
         if not same and fc["causes"]:
             from .spread import validation_values, widen
-            swapped = _library_builder(validate, fit, kv, kf, model, window, alpha, None)
+            swapped = library_builder(validate, fit, kv, kf, model, window, alpha, None)
             found = {c.name for c in fc["causes"]}
             fc = dict(fc, causes=widen(fc["causes"], validation_values(swapped, [n for n in force_names if n in found])))
         if not same and split is None:
-            fc = _validation_only(fc, force_names, model, validate, kf, kv, sensor, window if window_given else None,
+            fc = validation_only.search(fc, force_names, model, validate, kf, kv, sensor, window if window_given else None,
                                   (max_causes, alpha, min_gain, alpha_reference), untested, notes)
     else:
         if force_names:
@@ -499,202 +380,6 @@ def _loop_admission(fc: dict, fit: Measurement, validate: Measurement) -> dict:
     return out
 
 
-def _library_builder(fit: Measurement, validate: Measurement, kf: Kinematics, kv: Kinematics, model: NominalModel,
-                     window: float, alpha: float, notes: list | None):
-    """names -> Library: the force channel's library on two records with their kinematics (used
-    samples marked), the saturation the records show, the instrument trajectories and the
-    estimation's error (said in ``notes`` unless None)."""
-    from .force import Library
-    from .method_error import method_error
-    step = max(1, int(round(kf.window / fit.dt)) // 3)
-    sat = measured_saturation(fit, validate, model, alpha)
-    kr = reference_kinematics(validate, sat(model), window=window)
-    kfr = reference_kinematics(fit, sat(model), window=window) if kr is not None else None
-    inst = ((lambda m: reference_kinematics(validate, sat(m), window=window)) if kr is not None and model.controller is not None
-            else None)
-    errors = (method_error(fit, kf, model), method_error(validate, kv, model))
-    if notes is not None and any(e is not None for e in errors):
-        notes.append(METHOD_NOTE.format(*(("not formed" if e is None else f"{e.rms:.3g} N RMS") for e in errors)))
-    return lambda names: Library(names, kf, kv, model, kf.moving, kv.moving, step, kr, inst, errors, kfr)
-
-
-def _validation_only(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kinematics, kv: Kinematics,
-                     sensor: dict, window: float | None, rule: tuple, untested: list, notes: list) -> dict:
-    """The force channel's result with the causes only the validation record can show: those
-    ``untestable`` on the fitting record (it moves one way only, it has no band to see a
-    resonance in) or partly ``unseen`` there (a resonance above its band: then one found where
-    the fitting record could show it is rejected, ``seen``) and testable on the validation record
-    are searched on alternate blocks of the validation record (:func:`_interleaved`) and judged on the others, on top of the model the
-    channel extended (reporting10 d0313 and d0327: a Coulomb level 8 % and 2 % low, the fitting
-    record sliding one way, where a level is an offset, left untested). Their rows in
-    ``untested`` are replaced by what that search says.
-    fc is returned unchanged when there are none or the parts are not :func:`_informative`."""
-    ext = fc["model"]
-    found = [c.name for c in fc["causes"]]
-    blind = {n: untestable(n, kf, ext) for n in names}
-    # a cause the fitting record can test in part: only a value beyond that part is the
-    # validation record's to show (``seen``)
-    partly = {n: why for n in names if not blind[n] and n not in found and (why := unseen(n, kf, kv, ext))}
-    reasons = {n: blind[n] or partly.get(n) for n in names}
-    cross = {n: r for n, r in reasons.items() if r and not untestable(n, kv, ext)}
-    parts = _interleaved(validate, ext, sensor, window) if cross else None
-    if parts is None:
-        return fc
-    fit2, val2, w2, kf2, kv2 = parts
-    cross = {n: r for n, r in cross.items() if not (untestable(n, kf2, ext) or untestable(n, kv2, ext))}
-    if not cross:
-        return fc
-    max_causes, alpha, min_gain, alpha_reference = rule
-    # judged from the nominal model among the causes found on the fitting data (refitted: fitted
-    # on that record alone they carry its errors; reporting10 d0370, an offset 7 % high on a
-    # one-way record, which an asymmetry took up) and the cross causes' family (reporting9
-    # d0348: an "asymmetry" of 54.2 and 54.6 N s/m, a viscous change, beside a delay): only a
-    # cross cause this search keeps is reported
-    mates = [n for n in names if n not in cross and n not in found
-             and any(CAUSES[n].FAMILY == CAUSES[c].FAMILY for c in cross)]
-    inner: list = []
-    judged = _identified_force_channel(_library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None),
-                                       list(cross) + found + mates, model, max_causes, alpha, min_gain,
-                                       alpha_reference, inner)
-    from .force import compatible
-    held = [n for n in cross if n in {c.name for c in judged["causes"]}]
-    # a cross cause kept in place of a found one it excludes would be refitted on top of it
-    # (level_asymmetry, untestable on a one-way fitting record, over an offset found there)
-    clash = {n: [c for c in found if not compatible([n, c])] for n in held}
-    held = [n for n in held if not clash[n]]
-    fc2, inside = dict(causes=[], model=ext, alternatives=[], explanations=[], rejected=[]), {}
-    for _ in range(len(held)):        # each pass drops at least one held cause or ends the loop
-        # judged on top of the model the fitting data extended
-        fc2 = _identified_force_channel(_library_builder(fit2, val2, kf2, kv2, ext, w2, alpha, None), held, ext,
-                                        max_causes, alpha, min_gain, alpha_reference, [])
-        # a cross cause found where the fitting record can show it after all (a resonance inside
-        # its band) is what that record did not show
-        bad = {c.name: why for c in fc2["causes"] if c.name in partly and (why := seen(c.name, c.hyper, kf, ext))}
-        if not bad:
-            break
-        inside.update(bad)
-        held = [n for n in held if n not in bad]
-        fc2 = dict(causes=[], model=ext, alternatives=[], explanations=[], rejected=[])
-    kept = {c.name for c in fc2["causes"]}
-    joint = _joint_values(found, [n for n in cross if n in kept], parts, model, rule) if kept else None
-    fc2["rejected"] = [r for r in judged["rejected"] if r["name"] in cross and r["name"] not in kept] + [
-        r for r in fc2["rejected"] if r["name"] in cross]
-    fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "
-                                                          "data") for n in held if n not in kept]
-    fc2["rejected"] += [dict(name=n, step="refit", reason=why) for n, why in inside.items()]
-    fc2["rejected"] += [dict(name=n, step="refit", reason=f"it cannot be combined with {', '.join(c)}, found on the "
-                                                          "fitting data") for n, c in clash.items() if c]
-    for c in judged["causes"]:
-        if c.name not in cross and c.name not in found:
-            fc2["rejected"] = [dict(r, reason=f"{r['reason']}; {c.name} explains these data in its place")
-                               if r["name"] in cross else r for r in fc2["rejected"]]
-    inner = [u for u in inner if u["name"] in cross]
-    untested[:] = [u for u in untested if u["name"] not in cross] + inner
-    said = ", ".join(cross)
-    notes.append(VALIDATION_ONLY_NOTE.format(names=said, reasons="; ".join(f"{n}: {r}" for n, r in cross.items()),
-                                             val=validate.name))
-    rejected = [dict(r, reason=f"{r['reason']} (fitted on alternate blocks of {validate.name}, judged on the others)")
-                for r in fc2["rejected"]]
-    # the validation record's force residual with the causes found here too (the summary's
-    # "force residual RMS" is the whole extended model's)
-    causes, model_out, shadows = list(fc["causes"]) + list(fc2["causes"]), fc2["model"], []
-    if joint is not None:
-        values, model_out = joint
-        shadows = [c for c in fc["causes"] if c.name not in values]
-        causes = [_with_values(c, values[c.name]) for c in causes if c.name in values]
-        r_val_ext = fc["r_val_nom"] - _force_change(causes, kv, model)
-        rejected += [dict(name=c.name, step="refit", statistic=c.statistic, p_value=c.p_value,
-                          validation_gain=c.score, reason=SHADOW_REASON.format(
-                              val=validate.name, cross=", ".join(n for n in values if n not in found)))
-                     for c in shadows]
-    else:
-        r_val_ext = fc["r_val_ext"] - _force_change(fc2["causes"], kv, ext)
-    extended = _rms(r_val_ext[np.isfinite(r_val_ext)]) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
-    return dict(fc, causes=causes, rejected=_partly_rows(fc["rejected"], rejected, partly, kept),
-                model=model_out, alternatives=[a for a in list(fc["alternatives"]) + list(fc2["alternatives"])
-                                               if a.get("replaces") not in {c.name for c in shadows}],
-                explanations=list(fc["explanations"]) + list(fc2["explanations"]), r_val_ext=r_val_ext,
-                extended=extended)
-
-
-def _partly_rows(first: list, second: list, partly: dict, kept: set) -> list:
-    """The rejected rows of the fitting record's search (``first``) and of the validation-only
-    search (``second``), one row per cause: a cause the fitting record can show in part
-    (``partly``) that the second search kept has no row; one it rejected there too has one row,
-    the first's, with both reasons."""
-    again = {r["name"]: r["reason"] for r in second if r["name"] in partly}
-    out = []
-    for r in first:
-        if r["name"] in kept:
-            continue
-        if r["name"] in again:
-            r = dict(r, reason=f"{r['reason']}; and where only the validation record can show it: {again[r['name']]}")
-        out.append(r)
-    said = {r["name"] for r in first}
-    return out + [r for r in second if not (r["name"] in partly and r["name"] in said)]
-
-
-def _joint_values(found: list, cross: list, parts: tuple, model: NominalModel, rule: tuple):
-    """({cause: its force-channel Cause}, extended model): the causes ``found`` on the fitting
-    record and those only the validation record can show (``cross``, kept there) searched together
-    from ``model`` on the validation record's alternate blocks ``parts`` (:func:`_interleaved`),
-    their uncertainties widened by the other blocks' values (:mod:`~hunting.diagnose.spread`);
-    None where that search does not keep every cross cause. A found cause it does not keep is
-    left out of the dict: the validation record, which shows both, does not need it beside them.
-
-    The fitting record cannot show the cross causes' effect and carries it in its own causes'
-    values: a one-way record reads a viscous asymmetry's 220 N s/m times the speed as part of the
-    offset (reporting33 d0413: 11.3 N for a true 8.11; fitted together on the validation record's
-    blocks, 8.15 N and b+, b- within 1.2 % of the truth), or as an offset of its own (reporting34
-    d0427: 0.21 N beside b+, b- of 10.8 and 10.1 N s/m for a true viscous asymmetry of 11.3 and
-    9.7 and no offset; on the blocks the asymmetry alone, 11.30 and 9.65 N s/m)."""
-    from .spread import validation_values, widen
-    fit2, val2, w2, kf2, kv2 = parts
-    max_causes, alpha, min_gain, alpha_reference = rule
-    names = found + cross
-    joint = _identified_force_channel(_library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None), names, model,
-                                      max(max_causes, len(names)), alpha, min_gain, alpha_reference, [])
-    kept = [n for n in names if n in {c.name for c in joint["causes"]}]
-    if not set(cross) <= set(kept):
-        return None
-    swapped = _library_builder(val2, fit2, kv2, kf2, model, w2, alpha, None)
-    causes = widen(joint["causes"], validation_values(swapped, kept))
-    return {c.name: c for c in causes}, joint["model"]
-
-
-def _with_values(cause: Cause, values: Cause) -> Cause:
-    """``cause`` (its test, score and gain) with the parameters, uncertainties, coefficients and
-    hyper-parameters of another fit of it (``values``)."""
-    return replace(cause, parameters=values.parameters, sigma=values.sigma, hyper=values.hyper, theta=values.theta,
-                   increments=values.increments)
-
-
-def _force_change(causes: list, kin: Kinematics, model: NominalModel) -> np.ndarray:
-    """The force-channel causes' summed force change (n,) [N] on a record, each at its fitted
-    coefficients and hyper-parameters on top of ``model`` (0 without causes)."""
-    from .force import member_force
-    out = np.zeros(kin.t.size)
-    for c in causes:
-        out += member_force(c.name, c.hyper, c.theta, kin, model)
-    return out
-
-
-def measured_saturation(fit: Measurement, validate: Measurement, model: NominalModel, alpha: float):
-    """model -> model: the controller with the saturation the measured output piles up at (the
-    saturation cause's evidence, p < alpha), where the model's controller has none at that level;
-    the identity otherwise. The instrument trajectories re-simulate the loop from the reference:
-    a loop that saturates follows it otherwise only where it does not, and a force-channel cause
-    beside the saturation failed its instrument check (reporting9 d0554 mass and d0568 lag, found
-    since; reporting8 d0560's viscous still fails it), beside a saturation the own channel found."""
-    from .causes import saturation as sat
-    if model.controller is None:
-        return lambda m: m
-    U, top, _, p = sat.evidence(sat.records_output(fit, validate))
-    if not (p < alpha and top >= sat.MIN_AT_BOUND and U > 0 and sat.model_level(model) > 1.01 * U):
-        return lambda m: m
-    return lambda m: m.replace(controller=dict(m.controller, saturation=U)) if m.controller is not None else m
-
-
 def one_way_offset(result: list, untested: list, model: NominalModel, kin: Kinematics) -> list:
     """A note (list of str) when an offset is reported on a record that moves one way only
     against a curve without a Stribeck dip (the level cause untested for that): there a constant
@@ -729,88 +414,12 @@ def worse_resimulation(view: dict) -> list:
     return out
 
 
-# the force channel needs the used samples of each record to span this many smoothing windows:
-# the residual is smoothed over one, so it has about that many independent values (tuning-clean
-# d0108: a "viscous" judged on a validation record whose used samples span 0.6 windows; on tuning,
-# tuning-clean, reporting5 and reporting6 the records under 3 windows held one true force cause,
-# that false alarm and one wrong cause)
-MIN_WINDOWS = 3
-WINDOW_CYCLES = 0.5      # the smoothing window, in periods of the loop's bandwidth (at least 31 samples)
-
-
-# the fitting record lacks what the force channel fits on, the validation record has it: the
-# validation record is split as the data are without validation data (reporting9 d0398: 56
-# sliding samples in a 7 s fitting record that creeps at 0.3 mm/s, an offset of 79 % of the
-# validation residual went unreported; d0308: all of its fitting record inside the Stribeck dip)
-INTERLEAVE_WINDOWS = 8   # filter windows per block of :func:`_interleaved`
-VALIDATION_ONLY_NOTE = ("the fitting data cannot show {names} ({reasons}): searched on alternate blocks of "
-                        + str(INTERLEAVE_WINDOWS) + " filter windows of the validation data ({val}), on top of the "
-                        "causes found, and judged on the others")
-SHADOW_REASON = ("found on the fitting data, which cannot show {cross}; searched with it on alternate blocks of the "
-                 "validation data ({val}), which show both, it does not hold beside it: the fitting data saw {cross}'s "
-                 "effect as this cause")
 OTHER_EVIDENCE_NOTE = ("{name} is named from the {channel} cause's own evidence (its evidence line); on the sliding "
                        "samples (the force channel) it was not selected: {reason}")
 POOR_FIT_NOTE = ("the fitting data ({name}) have {n} sliding samples the force channel can use (away from stops, "
                  "the friction map not too steep there), spanning {windows:.1f} filter windows (it needs 100 spanning "
                  + str(MIN_WINDOWS) + "): the force channel fitted on the first 60 % of the validation data ({val}) and "
                  "judged on the rest; give a fitting record that slides in both directions to use all of them")
-
-
-def _split(record: Measurement) -> tuple[Measurement, Measurement]:
-    """(first 60 %, last 40 %) of a record by time: fitting and validation parts."""
-    t_split = record.t[0] + 0.6 * (record.t[-1] - record.t[0])
-    return record.part(record.t[0], t_split), record.part(t_split, record.t[-1] + record.dt)
-
-
-def _informative(kin) -> bool:
-    """Whether a record's used samples (``kin.moving``, :func:`used_samples`) suffice for the
-    force channel: at least 100, spanning at least MIN_WINDOWS filter windows."""
-    n = int(kin.moving.sum())
-    return n >= 100 and n * kin.dt / kin.window >= MIN_WINDOWS
-
-
-def _split_validation(validate: Measurement, model: NominalModel, sensor: dict, window: float | None):
-    """(fit, validate, window, kf, kv): the validation record's first 60 % and last 40 % with
-    their kinematics (used samples marked), the smoothing window ``window`` [s] or the parts'
-    default; None when either part is not :func:`_informative`."""
-    if validate.n < 250:
-        return None
-    fit, val = _split(validate)
-    w = default_window(fit, val, model) if window is None else window
-    kf, kv = (kinematics(m, model.cm, window=w, **sensor) for m in (fit, val))
-    kf, kv = (replace(k, moving=used_samples(k, model)) for k in (kf, kv))
-    if not (_informative(kf) and _informative(kv)):
-        return None
-    return fit, val, w, kf, kv
-
-
-def _interleaved(record: Measurement, model: NominalModel, sensor: dict, window: float | None):
-    """(fit, validate, window, kf, kv): one record split into alternate blocks of
-    INTERLEAVE_WINDOWS filter windows, the even blocks' used samples to fit on and the odd
-    blocks' to judge on (both parts see the motions the record has: a 60/40 split in time of a
-    record that moves one way and then the other leaves each part one-way); the smoothing window
-    ``window`` [s] or the record's default; None when either part is not :func:`_informative`."""
-    w = default_window(record, record, model) if window is None else window
-    k = kinematics(record, model.cm, window=w, **sensor)
-    k = replace(k, moving=used_samples(k, model))
-    even = (np.arange(k.t.size) * k.dt // (INTERLEAVE_WINDOWS * k.window)).astype(int) % 2 == 0
-    kf, kv = (replace(k, moving=k.moving & part, spectrum=k.moving) for part in (even, ~even))
-    if not (_informative(kf) and _informative(kv)):
-        return None
-    return record, record, w, kf, kv
-
-
-def default_window(fit: Measurement, validate: Measurement, model: NominalModel) -> float:
-    """The smoothing window [s]: 31 samples, or half a period of the loop's bandwidth when that is
-    longer (fast sampling: the acceleration's noise falls as the fifth power of the window, and
-    with it what feedback of that noise puts into the regressors), at most a quarter of the
-    shorter record."""
-    from .loop import loop_bandwidth
-    dt = fit.dt
-    f_bw = loop_bandwidth(model)
-    w = 31 * dt if not f_bw else max(31 * dt, WINDOW_CYCLES / f_bw)
-    return min(w, dt * (min(fit.n, validate.n) // 4))
 
 
 class _Progress:
@@ -828,146 +437,6 @@ class _Progress:
         else:
             self.fn(stage, min(self.k, self.total), self.total)
             self.k += 1
-
-
-def _rms(r) -> float:
-    return float(np.sqrt(np.mean(r ** 2)))
-
-
-def _identified_force_channel(library, names, model, max_causes, alpha, min_gain, alpha_reference, untested) -> dict:
-    """The force channel's result (:func:`_force_channel`) with every selected cause identified:
-    a cause whose ``unidentified(parameters, sigma)`` hook gives a reason (its fitted parameters do
-    not single it out, e.g. a reversal scale within two standard uncertainties of zero) is taken
-    out of the library and the channel judged again without it; each such cause gets a rejected
-    row (step "identification") ahead of the others. library(names) builds the Library; the
-    untested causes of the first one are appended to ``untested``. At most len(names) + 1 passes:
-    each pass but the last removes at least one cause."""
-    from .force import select
-    excluded: list = []
-    identification: list = []
-    for _ in range(len(names) + 1):
-        lib = library([n for n in names if n not in excluded])
-        if not excluded:
-            untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
-        fc = _force_channel(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference), min_gain)
-        fails = [(c, getattr(CAUSES[c.name], "unidentified", lambda *a: None)(c.parameters, c.sigma))
-                 for c in fc["causes"]]
-        fails = [(c, why) for c, why in fails if why]
-        if not fails:
-            break
-        excluded += [c.name for c, _ in fails]
-        identification += [dict(name=c.name, step="identification", statistic=c.statistic, p_value=c.p_value,
-                                validation_gain=c.gain["nominal"] / max(c.gain["extended"], 1e-300) - 1, reason=why)
-                           for c, why in fails]
-    if identification:
-        fc["rejected"] = identification + [r for r in fc["rejected"] if r["name"] not in excluded]
-    return fc
-
-
-def _force_channel(lib, model, sel, min_gain: float) -> dict:
-    """Causes, extended model, residuals and alternatives from the force channel's selection."""
-    from .force import compatible
-    from .refine import member_sigma, members_parameters, refine
-    ex = sel["explanation"]
-    mf, mv = lib.used_f, lib.used_v
-    cov, hyper_sigma, idle = None, {}, []
-    if ex.cols:
-        ex, _, cov, hyper_sigma = refine(lib, ex)
-        ex, cov, hyper_sigma, idle = _idle_after_refinement(lib, ex, cov, hyper_sigma, min_gain)
-    rows = members_parameters(lib, ex, cov)
-    pred_v = lib.prediction(ex, "v")
-    rv_ext = np.where(mv, lib.rv - pred_v, np.nan)
-    causes = []
-    for name, hyper, th, pars, sig, inc, _ in rows:
-        sig = member_sigma(name, pars, sig, hyper_sigma)
-        t = sel["tests"][name]
-        causes.append(Cause(name, t["gain"], t["t"], t["p_value"], pars, sig,
-                            dict(metric="force residual RMS [N], validation", nominal=t["rms_without"],
-                                 extended=t["rms"]), hyper, th, inc, CAUSES[name].FAMILY))
-    causes.sort(key=lambda c: -c.score)
-    ext = rows[-1][6] if rows else model
-    nominal_rms = _rms(lib.rv[mv])
-    # alternatives: (1) a cause of a selected one's family in its place; (2) a cause that explains
-    # the data alone (better BIC than the nominal model, validation gain >= min_gain) but not once the
-    # selected ones are in
-    alternatives, seen = [], {c.name for c in causes}
-    fits = sel["fits"]
-    chosen = set(ex.names)
-    for c in causes:
-        for mate in lib.variants:
-            if mate in seen or CAUSES[mate].FAMILY != c.family:
-                continue
-            alt_set = tuple(sorted((chosen - {c.name}) | {mate}, key=list(lib.variants).index))
-            if not compatible(alt_set):
-                continue
-            alt = fits.get(alt_set) or lib.best_variants(alt_set)
-            if not alt.physical:
-                continue
-            row = [r for r in members_parameters(lib, alt) if r[0] == mate][0]
-            alternatives.append(dict(name=mate, kind="same family", replaces=c.name, parameters=row[3],
-                                     bic_difference=float(alt.bic - ex.bic),
-                                     gain=dict(metric="force residual RMS [N], validation, in place of " + c.name,
-                                               nominal=nominal_rms, extended=lib.validation_rms(alt))))
-            seen.add(mate)
-    empty = fits[()]
-    for name in lib.variants:
-        if name in seen:
-            continue
-        alone = fits[(name,)]
-        if not alone.physical:
-            continue
-        rms1 = lib.validation_rms(alone)
-        if alone.bic < empty.bic and rms1 < (1 - min_gain) * nominal_rms:
-            row = members_parameters(lib, alone)[0]
-            alternatives.append(dict(name=name, kind="alone", absorbed_by=sorted(chosen), parameters=row[3],
-                                     bic_difference=float(alone.bic - ex.bic),
-                                     gain=dict(metric="force residual RMS [N], validation, alone", nominal=nominal_rms,
-                                               extended=rms1)))
-            seen.add(name)
-    # the search's best sets: BIC on the fitting data relative to the selected explanation
-    # (negative: a set that fits the fitting data better but whose extra causes did not hold on
-    # the validation data)
-    explanations = []
-    for alt in sel["ranking"][:6]:
-        if alt.names == ex.names:
-            continue
-        explanations.append(dict(causes=list(alt.names), bic_difference=float(alt.bic - ex.bic),
-                                 validation_rms=lib.validation_rms(alt),
-                                 pruned=sorted(set(alt.names) - set(ex.names))))
-        if len(explanations) == 4:
-            break
-    return dict(causes=causes, nominal=nominal_rms, extended=_rms(rv_ext[mv]), rejected=sel["rejected"] + idle,
-                alternatives=alternatives, explanations=explanations, model=ext,
-                r_fit=np.where(mf, lib.rf, np.nan), r_val_nom=np.where(mv, lib.rv, np.nan), r_val_ext=rv_ext)
-
-
-def _idle_after_refinement(lib, ex, cov, hyper_sigma, min_gain: float):
-    """(explanation, cov, hyper sigmas, rejected rows): the refined explanation without the
-    members its refinement left idle. The selection judged each member with the others at their
-    grid values; refined (a Stribeck velocity per direction moved between grid points), the
-    others can explain what a member took up there: reporting8 d0401's refined Stribeck dip left
-    the offset selected beside it at -7e-5 N. A member whose refined part, the others held, grows
-    the validation RMS by less than min_gain when dropped is removed and the rest refitted and
-    refined (one at a time, the smallest first; a single member stays: its tests judged it
-    against nothing)."""
-    from .refine import refine
-    idle = []
-    for _ in range(len(ex.members)):
-        if len(ex.members) < 2:
-            break
-        mv = lib.used_v
-        pred = lib.prediction(ex, "v")
-        rms = _rms((lib.rv - pred)[mv])
-        gains = {name: _rms((lib.rv - pred + lib.part(ex, name, "v"))[mv]) / max(rms, 1e-300) - 1.0 for name in ex.names}
-        name = min(gains, key=gains.get)
-        if gains[name] >= min_gain:
-            break
-        idle.append(dict(name=name, step="validation", statistic=None, p_value=None, validation_gain=gains[name],
-                         reason=f"once the hyper-parameters of the others are refined it explains less than {min_gain:.0%} "
-                                f"of the validation residual (validation gain {gains[name]:.1%})"))
-        ex = lib.best_variants(tuple(n for n in ex.names if n != name))
-        ex, _, cov, hyper_sigma = refine(lib, ex)
-    return ex, cov, hyper_sigma, idle
 
 
 def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolution, found=lambda names: False):
