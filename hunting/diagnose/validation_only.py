@@ -10,7 +10,7 @@ import numpy as np
 
 from .causes import CAUSES, seen, unseen, untestable
 from .data import Measurement
-from .force_channel import _rms, force_change, identified_force_channel, library_builder
+from .force_channel import force_change, identified_force_channel, library_builder
 from .kinematics import Kinematics
 from .model import NominalModel
 from .parts import INTERLEAVE_WINDOWS, interleaved
@@ -20,24 +20,23 @@ from .result import Cause
 VALIDATION_ONLY_NOTE = ("the fitting data cannot show {names} ({reasons}): searched on alternate blocks of "
                         + str(INTERLEAVE_WINDOWS) + " filter windows of the validation data ({val}), on top of the "
                         "causes found, and judged on the others")
-
-
 SHADOW_REASON = ("found on the fitting data, which cannot show {cross}; searched with it on alternate blocks of the "
                  "validation data ({val}), which show both, it does not hold beside it: the fitting data saw {cross}'s "
                  "effect as this cause")
 
 
 def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kinematics, kv: Kinematics,
-                     sensor: dict, window: float | None, rule: tuple, untested: list, notes: list) -> dict:
+           sensor: dict, window: float | None, rule: tuple, untested: list, notes: list) -> dict:
     """The force channel's result with the causes only the validation record can show: those
     ``untestable`` on the fitting record (it moves one way only, it has no band to see a
-    resonance in) or partly ``unseen`` there (a resonance above its band: then one found where
-    the fitting record could show it is rejected, ``seen``) and testable on the validation record
-    are searched on alternate blocks of the validation record (:func:`interleaved`) and judged on the others, on top of the model the
-    channel extended (reporting10 d0313 and d0327: a Coulomb level 8 % and 2 % low, the fitting
-    record sliding one way, where a level is an offset, left untested). Their rows in
-    ``untested`` are replaced by what that search says.
-    fc is returned unchanged when there are none or the parts are not :func:`informative`."""
+    resonance in) or partly ``unseen`` there (a resonance above its band, a cogging pitch longer
+    than its stroke: then one found where the fitting record could show it is rejected, ``seen``)
+    and testable on the validation record are searched on alternate blocks of the validation
+    record (:func:`~hunting.diagnose.parts.interleaved`) and judged on the others, on top of the
+    model the channel extended (reporting10 d0313 and d0327: a Coulomb level 8 % and 2 % low, the
+    fitting record sliding one way, where a level is an offset, left untested). Their rows in
+    ``untested`` are replaced by what that search says. fc is returned unchanged when there are
+    none or the parts are not :func:`~hunting.diagnose.parts.informative`."""
     ext = fc["model"]
     found = [c.name for c in fc["causes"]]
     blind = {n: untestable(n, kf, ext) for n in names}
@@ -118,7 +117,8 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
                      for c in shadows]
     else:
         r_val_ext = fc["r_val_ext"] - force_change(fc2["causes"], kv, ext)
-    extended = _rms(r_val_ext[np.isfinite(r_val_ext)]) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
+    finite = r_val_ext[np.isfinite(r_val_ext)]
+    extended = float(np.sqrt(np.mean(finite ** 2))) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
     return dict(fc, causes=causes, rejected=_partly_rows(fc["rejected"], rejected, partly, kept),
                 model=model_out, alternatives=[a for a in list(fc["alternatives"]) + list(fc2["alternatives"])
                                                if a.get("replaces") not in {c.name for c in shadows}],
