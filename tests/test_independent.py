@@ -94,3 +94,29 @@ def test_a_noise_free_clean_record_gets_reasons_in_words_not_relative_changes_of
     assert "makes its re-simulated position error" in reasons["dwell"] and "against 0 m without" in reasons["dwell"]
     json.dumps(dg.as_dict(), allow_nan=False)
 
+
+
+def test_a_build_up_outside_lugres_range_at_the_refined_bristles_is_not_named(tmp_path):
+    """Seed 8 d0041: a lightly damped resonance (35 Hz, 60 % of the mass on the spring) whose
+    fitting record slides too little to test it. The force channel's reversal, refined with the
+    scale held at 1, re-estimated the build-up at 5.85 times LuGre's at sigma0 = 997 kN/m, outside
+    the range the search accepts as LuGre's (0.3..3), and was named first; it is rejected at the
+    identification step now, and no bristles are named for a resonance."""
+    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(tmp_path), "--seed", "8",
+                    "--only", "41"], check=True, capture_output=True)
+    dd = tmp_path / "d0041"
+    assert json.loads((dd / "truth.json").read_text())["causes"] == ["flexibility"]
+    dg = diagnose(load(dd / "fit.npz"), NominalModel.from_json(dd / "model.json"), load(dd / "val.npz"))
+    assert "reversal" not in [c.name for c in dg.causes], [(c.name, c.parameters, c.sigma) for c in dg.causes]
+    row = next(r for r in dg.rejected if r["name"] == "reversal")
+    assert row["step"] == "identification" and "times LuGre's (accepted 0.3..3" in row["reason"], row
+
+
+def test_reversal_identification_judges_the_refined_scale():
+    """reversal.unidentified on its own: a scale outside SCALE_RANGE or within MIN_SCALE_Z
+    uncertainties of zero is not LuGre's build-up; a scale near 1 far from zero is."""
+    from hunting.diagnose.causes import reversal
+    assert reversal.unidentified({"scale": 1.0}, {"scale": 0.05}) is None
+    assert "times LuGre's" in reversal.unidentified({"scale": 5.85}, {"scale": 1.43})
+    assert "times LuGre's" in reversal.unidentified({"scale": 0.2}, {"scale": 0.01})
+    assert "within 2 standard uncertainties" in reversal.unidentified({"scale": 1.0}, {"scale": 0.6})
