@@ -192,15 +192,16 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     windows = min(k.moving.sum() * k.dt / k.window for k in (kf, kv))
     if force_names and informative(kf) and informative(kv):
         fc = identified_force_channel(library_builder(fit, validate, kf, kv, model, window, alpha, notes),
-                                       force_names, model, max_causes, alpha, min_gain, alpha_reference, untested)
+                                      force_names, model, max_causes, alpha, min_gain, alpha_reference, untested)
         if not same and fc["causes"]:
             from .spread import validation_values, widen
             swapped = library_builder(validate, fit, kv, kf, model, window, alpha, None)
             found = {c.name for c in fc["causes"]}
             fc = dict(fc, causes=widen(fc["causes"], validation_values(swapped, [n for n in force_names if n in found])))
         if not same and split is None:
-            fc = validation_only.search(fc, force_names, model, validate, kf, kv, sensor, window if window_given else None,
-                                  (max_causes, alpha, min_gain, alpha_reference), untested, notes)
+            fc = validation_only.search(fc, force_names, model, validate, kf, kv, sensor,
+                                        window if window_given else None,
+                                        (max_causes, alpha, min_gain, alpha_reference), untested, notes)
     else:
         if force_names:
             why = ("fewer than 100 sliding samples (|v| > 2 % of the maximum, half a filter window from stops and "

@@ -73,19 +73,19 @@ def hypers(kin, model) -> list:
         return []
     r_all = residual(kin, model)
     q, r = kin.q[moving], r_all[moving]
-    stroke = float(np.ptp(q))
+    travel = stroke(kin)
     # short pitches show where the motion is slow (a pitch shorter than 20 samples' travel at the
     # median speed missed a 0.58 mm cogging moved at 13-58 mm/s, tuning d0088); two periods in
     # the stroke suffice to tell a periodic force (a 1.7 mm pitch over 6.5 mm, d0153)
     step = float(np.percentile(np.abs(np.diff(kin.q)[moving[1:]]), 10))
-    lo, hi = 5 * step, stroke / MIN_PERIODS
+    lo, hi = 5 * step, travel / MIN_PERIODS
     if not (lo > 0 and hi > lo):
         return []
     k = np.geomspace(1 / hi, 1 / lo, 1500)                  # wavenumbers [1/m], 0.2-0.4 % apart
     # the spectrum of the residual averaged in position bins of a tenth of the shortest
     # wavelength: what is periodic in q survives the averaging, the cost falls from the samples
     # (tens of thousands, visited again and again) to the bins
-    width = max(lo / 10, stroke / 2000)                     # at most ~2000 bins
+    width = max(lo / 10, travel / 2000)                     # at most ~2000 bins
     idx = np.floor((q - q.min()) / width).astype(np.int64)
     counts = np.bincount(idx)
     full = counts > 0
