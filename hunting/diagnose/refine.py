@@ -167,6 +167,8 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
         held = tuple(fixed)
         held_fit = descend(starts(fitted(cur["members"], held), held, set(fixed)), held, 2 * iterations)
         cur = fitted(held_fit["members"], ())      # the free coefficients at the extension's hyper-parameters
+    if not physical(cur["members"], cur["theta"], ()):
+        return _unrefined(fitted(ex.members, ()), ex, physical)
     members, X, theta = cur["members"], cur["X"], cur["theta"]
     sig = {}
     if has_keys:
@@ -178,6 +180,19 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
                 sig.setdefault(name, {})[key] = float(h * np.sqrt(max(hc[0][hc[1] + i, hc[1] + i], 0.0)))
                 i += 1
     return Explanation(tuple(members), theta, ex.bic, cur["rss"], list(range(X.shape[1]))), theta, cov, sig
+
+
+def _unrefined(start: dict, ex: Explanation, physical):
+    """refine's answer where the refined fit is not physical: the explanation at its grid
+    variants, re-estimated (``start``, refine's own fit) where that is physical, else with the
+    search's coefficients and no covariance. Two members that one record cannot tell apart (an
+    offset and a Coulomb level on a record that moves one way) make the design all but singular:
+    the re-estimate split their common force into +-2.2e8 N (reporting38 d0443, a Stribeck level
+    of -2.2e8 N reported beside an offset of -2.2e8 N), which the grid fit had split into +-0.22 N."""
+    if physical(start["members"], start["theta"], ()):
+        return (Explanation(tuple(start["members"]), start["theta"], ex.bic, start["rss"],
+                            list(range(start["X"].shape[1]))), start["theta"], start["cov"], {})
+    return ex, ex.theta, None, {}
 
 
 def _hyper_bounds(lib: Library, members) -> dict:
