@@ -1214,3 +1214,22 @@ def test_a_drive_below_the_coulomb_friction_is_said_where_the_force_channel_is_s
     d = diagnose(fit, model, val, behaviour=False, causes=["level"])
     assert [c.name for c in d.causes] == ["level"]
     assert not any("never exceeds" in n for n in d.notes), d.notes
+
+
+def test_a_refinement_that_leaves_the_physical_range_is_not_reported():
+    """reporting38 d0443: a Stribeck dip (Fs 11.06 N over Fc 10.17 N) on a fitting record that
+    moves one way only, where an offset and a change of the Coulomb level are the same force.
+    The search split their common force into -0.22 and +0.22 N; the refinement's re-estimate into
+    -2.2e8 N each, and the report named a Stribeck level of -2.2e8 N beside an offset of -2.2e8 N
+    (the extended model's validation force error 6.8e7 N RMS against 0.59). A refined fit that is
+    not physical is replaced by the grid variants' (refine._unrefined): every reported level is
+    positive, Fs within 5 % of the truth, the offset below the Coulomb level, and the extended
+    model's validation error below the nominal one's."""
+    fit, val, model, truth = _dataset("reporting38", 443)
+    d = diagnose(fit, model, val, behaviour=False)
+    got = {c.name: c.parameters for c in d.causes}
+    assert "stribeck" in got, ([(c.name, c.parameters) for c in d.causes], d.rejected)
+    assert got["stribeck"]["Fc"] > 0 and got["stribeck"]["Fs"] > got["stribeck"]["Fc"], got
+    assert got["stribeck"]["Fs"] == pytest.approx(truth["effects"][0]["params"]["Fs"], rel=0.05)
+    assert abs(got.get("offset", {}).get("offset", 0.0)) < model.curve.negative.Fc, got
+    assert d.extended < d.nominal, (d.nominal, d.extended)
