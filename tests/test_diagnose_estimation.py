@@ -1233,3 +1233,18 @@ def test_a_refinement_that_leaves_the_physical_range_is_not_reported():
     assert got["stribeck"]["Fs"] == pytest.approx(truth["effects"][0]["params"]["Fs"], rel=0.05)
     assert abs(got.get("offset", {}).get("offset", 0.0)) < model.curve.negative.Fc, got
     assert d.extended < d.nominal, (d.nominal, d.extended)
+
+
+def test_the_validation_test_is_not_whitened_by_the_effect_it_tests():
+    """reporting38 d0341: the Coulomb and static levels 42 % above a LuGre nominal model's, on
+    records of 107 thinned validation samples. The whole library fitted on the fitting record
+    predicted the validation record badly, and the AR model of that validation residual (phi =
+    0.95, the effect itself) made the out-of-sample test a differencing filter: the level's part
+    explained 99 % of the raw validation residual and read t = 0.77, and nothing was named. The
+    tests now prewhiten with the fitting record's noise model: the level is named (as ``stribeck``,
+    which the draw accepts: the levels scaled at the nominal shape), first, with Fs within 10 %."""
+    fit, val, model, truth = _dataset("reporting38", 341)
+    d = diagnose(fit, model, val, behaviour=False)
+    names = [c.name for c in d.causes]
+    assert names and names[0] in truth["effects"][0]["accept"], (names, d.rejected)
+    assert d.causes[0].parameters["Fs"] == pytest.approx(truth["effects"][0]["params"]["Fs"], rel=0.1)

@@ -47,10 +47,9 @@ whose causes all hold there and none of them dropped replaces it when it has as 
 predicts the validation data better by ``min_gain``, or fewer and predicts them not worse by
 ``min_gain`` (:func:`_rival`: the fitting data's BIC can prefer a set that the validation data
 contradict, and the rule that a set must beat its own subsets holds for every smaller set). Every change of the set drops at least one cause for good,
-so the loop ends. The out-of-sample tests' noise model
-is fitted on the validation residual of the whole library (coefficients from the fitting data),
-without its unphysical members when that prediction is worse than none, and when it still is
-(signatures collinear on the fitting data only), on the nominal validation residual. What remains is the
+so the loop ends. The out-of-sample tests prewhiten with the search's own noise model (the
+fitting record's residual of the whole library); their standard error comes from the validation
+residual's own autocorrelation (:func:`~hunting.diagnose.stats.out_of_sample`). What remains is the
 explanation; the sets that came next in BIC and the causes of the same family (shared
 signature) that would replace a selected one are its alternatives."""
 from __future__ import annotations
