@@ -100,8 +100,11 @@ def test_a_build_up_outside_lugres_range_at_the_refined_bristles_is_not_named(tm
     """Seed 8 d0041: a lightly damped resonance (35 Hz, 60 % of the mass on the spring) whose
     fitting record slides too little to test it. The force channel's reversal, refined with the
     scale held at 1, re-estimated the build-up at 5.85 times LuGre's at sigma0 = 997 kN/m, outside
-    the range the search accepts as LuGre's (0.3..3), and was named first; it is rejected at the
-    identification step now, and no bristles are named for a resonance."""
+    the range the search accepts as LuGre's (0.3..3), and was named first; it was rejected at the
+    identification step since the twenty-ninth session, and since the thirtieth (the validation
+    tests' noise model from the fitting record where the validation residual's innovations are
+    more than 4 times its own) already out of sample (p = 0.49); no bristles are named for a
+    resonance. The identification step itself: test_reversal_identification_judges_the_refined_scale."""
     subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(tmp_path), "--seed", "8",
                     "--only", "41"], check=True, capture_output=True)
     dd = tmp_path / "d0041"
@@ -109,7 +112,8 @@ def test_a_build_up_outside_lugres_range_at_the_refined_bristles_is_not_named(tm
     dg = diagnose(load(dd / "fit.npz"), NominalModel.from_json(dd / "model.json"), load(dd / "val.npz"))
     assert "reversal" not in [c.name for c in dg.causes], [(c.name, c.parameters, c.sigma) for c in dg.causes]
     row = next(r for r in dg.rejected if r["name"] == "reversal")
-    assert row["step"] == "identification" and "times LuGre's (accepted 0.3..3" in row["reason"], row
+    assert ((row["step"] == "identification" and "times LuGre's (accepted 0.3..3" in row["reason"])
+            or (row["step"] == "validation" and "not significant out of sample" in row["reason"])), row
 
 
 def test_reversal_identification_judges_the_refined_scale():
