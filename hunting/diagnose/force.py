@@ -356,11 +356,32 @@ class Library:
             if s is not None:
                 js = self.n_cols + s
                 sq += 2.0 * th @ U[cols, js] + U[js, js]
-            size = float(np.sqrt(max(sq, 0.0) / m))
-            if size > CANCEL * self.drive_rms:
-                out[name] = (f"its force change ({size:.3g} N RMS) is {size / max(self.drive_rms, 1e-300):.3g} times the "
-                             "drive force's: cancelled by the other causes of the set, not an effect of its own")
+            why = self._cancelled(float(np.sqrt(max(sq, 0.0) / m)))
+            if why:
+                out[name] = why
         return out
+
+    def cancelling_variants(self, members, theta) -> dict:
+        """:meth:`cancelling` computed from the members' own regressors on the thinned fitting
+        data, for variants added after the Gram matrix was built (the refinement's): reporting38
+        d0443's refined Stribeck level and offset each changed the force by 1.1e8 N, cancelling
+        to the grid fit's 0.22 N, and each was physical on its own."""
+        out, k, idx = {}, 0, self.Sf.idx
+        for name, j in members:
+            v = self.variants[name][j]
+            kk = v.Xf.shape[1]
+            why = self._cancelled(_rms(v.Xf[idx] @ theta[k:k + kk] + v.sf[idx]) if idx.size else 0.0)
+            k += kk
+            if why:
+                out[name] = why
+        return out
+
+    def _cancelled(self, size: float) -> str | None:
+        """Why a member whose force change is ``size`` N RMS is cancelled by its set, or None."""
+        if size <= CANCEL * self.drive_rms:
+            return None
+        return (f"its force change ({size:.3g} N RMS) is {size / max(self.drive_rms, 1e-300):.3g} times the "
+                "drive force's: cancelled by the other causes of the set, not an effect of its own")
 
     def best_variants(self, names, start=None) -> Explanation:
         """The explanation with the causes ``names``, each at its best variant given the others

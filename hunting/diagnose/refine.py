@@ -88,7 +88,8 @@ def refine(lib: Library, ex: Explanation, *, iterations: int = 4, max_step: floa
             kk = lib.variants[name][j].Xf.shape[1]
             full.append(fixed[name] if name in held else theta[k:k + kk])
             k += 0 if name in held else kk
-        return not unphysical_members(lib, mem, np.concatenate(full) if full else np.zeros(0))
+        theta = np.concatenate(full) if full else np.zeros(0)
+        return not unphysical_members(lib, mem, theta) and not (len(mem) > 1 and lib.cancelling_variants(mem, theta))
 
     def fitted(mem, held):
         X, Z, s = design(mem, held)
