@@ -477,6 +477,26 @@ def test_a_fitting_record_that_hardly_slides_gives_way_to_the_validation_record(
     assert any("first 60 % of the validation data" in n for n in d.notes), d.notes
 
 
+def test_a_validation_record_that_ends_at_rest_is_split_into_alternate_blocks():
+    """reporting40 d0444: a viscous change of 27 % (validation gain 0.48 when modelled) behind a
+    fitting record that never slides (0 usable samples) and a validation record whose last 40 %
+    is rests and a slow sine (the 60/40 split in time leaves it too few): the force channel was
+    skipped and nothing was reported. Fitted on alternate blocks of the validation record and
+    judged on the others, the viscous change is named alone, b within 2 %; the report says how it
+    was judged and holds no force residual on the fitting record. A clean record on the same path
+    (reporting39 d0026) reports nothing."""
+    fit, val, model, truth = _dataset("reporting40", 444)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["viscous"], ([(c.name, c.parameters) for c in d.causes], d.notes)
+    assert d.causes[0].parameters["b"] == pytest.approx(truth["effects"][0]["params"]["b"], rel=0.02)
+    assert any("alternate blocks of 8 filter windows of the validation data" in n for n in d.notes), d.notes
+    assert np.all(np.isnan(d.r_fit_nominal))
+    fit, val, model, truth = _dataset("reporting39", 26)
+    assert not truth["effects"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == [] and any("alternate blocks" in n for n in d.notes), ([c.name for c in d.causes], d.notes)
+
+
 def test_stribeck_velocity_between_grid_points_is_found():
     """reporting9 d0443: the Stribeck velocity changed from 5.7 to 3.1 mm/s in both directions,
     below the slowest used speed (9.8 mm/s). The best grid point (9.8 and 4.9 mm/s) left 15 times
