@@ -444,7 +444,8 @@ def worse_resimulation(view: dict) -> list:
     return out
 
 
-BLOCKS_LOOP_WHY = ("too few sliding samples in the fitting data for the force channel on the two records, and nothing named on the validation record's alternate blocks")
+BLOCKS_LOOP_WHY = ("too few sliding samples in the fitting data for the force channel on the two records, and nothing "
+                   "named on the validation record's alternate blocks")
 OTHER_EVIDENCE_NOTE = ("{name} is named from the {channel} cause's own evidence (its evidence line); on the sliding "
                        "samples (the force channel) it was not selected: {reason}")
 _POOR_FIT = ("the fitting data ({name}) have {n} sliding samples the force channel can use (away from stops, "
