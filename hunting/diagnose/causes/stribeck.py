@@ -70,6 +70,44 @@ def hypers(kin, model) -> list:
 
 ONE_WAY = 0.1     # a record with less than this share of its sliding samples one way slides the other way only
 
+# the validation record's top speed over the fitting record's beyond which a dip above the
+# fitting record's speeds is the validation record's to show (:func:`unseen`); the factor of
+# cogging's stroke and flexibility's band (their UNSEEN_FACTOR)
+UNSEEN_FACTOR = 3.0
+
+
+def top_speed(kin) -> float:
+    """The 90th percentile of the record's sliding speeds |v| [m/s] (0 with fewer than 10 sliding
+    samples): the top of the speed band its friction curve is seen over."""
+    speed = np.abs(kin.v[kin.moving])
+    return float(np.percentile(speed, 90)) if speed.size >= 10 else 0.0
+
+
+def unseen(kf, kv, model) -> str | None:
+    """Why the fitting record (``kf``) cannot show a dip the validation record (``kv``) can: the
+    validation record slides more than UNSEEN_FACTOR times faster (:func:`top_speed`), and a dip
+    whose velocity lies between the two reads on the fitting record as a level (reporting41
+    d0331: vs 7.3 mm/s for a nominal 2.7, the fitting record sliding up to 4.3 mm/s, the
+    validation record to 22; the fit on the fitting record predicted the validation record 37 %
+    worse than the nominal, and nothing was named for a change of 94 % of its residual)."""
+    sf, sv = top_speed(kf), top_speed(kv)
+    if sf <= 0 or sv <= UNSEEN_FACTOR * sf:
+        return None
+    return (f"a Stribeck velocity above {_q(sf, None, 'm/s')} (the fitting record slides up to {_q(sf, None, 'm/s')}, "
+            f"the validation record up to {_q(sv, None, 'm/s')})")
+
+
+def seen(hyper, kf, model) -> str | None:
+    """Why a dip found on the validation record alone (:func:`unseen`) is one the fitting record
+    could show, where it showed none: its velocity (the nominal's for the static level alone,
+    ``dip``) at most the fitting record's top speed."""
+    vs = model.curve.positive.vs if hyper.get("dip") else max(hyper["vs"], _vs_neg(hyper))
+    top = top_speed(kf)
+    if vs > top:
+        return None
+    return (f"its Stribeck velocity ({_q(vs, None, 'm/s')}) lies in the fitting record's speeds (up to "
+            f"{_q(top, None, 'm/s')}), where that record shows none")
+
 
 def hyper_keys(hyper) -> tuple:
     """The refined hyper-parameters of a variant: vs alone where the dip is ``tied``, none for the
