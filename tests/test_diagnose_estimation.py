@@ -1324,3 +1324,26 @@ def test_the_validation_test_is_not_whitened_by_the_effect_it_tests():
     names = [c.name for c in d.causes]
     assert names and names[0] in truth["effects"][0]["accept"], (names, d.rejected)
     assert d.causes[0].parameters["Fs"] == pytest.approx(truth["effects"][0]["params"]["Fs"], rel=0.1)
+
+
+def test_stribeck_unseen_and_seen_read_the_records_top_speeds():
+    """stribeck.unseen on its own: a validation record sliding more than UNSEEN_FACTOR times
+    faster (90th percentile speed) than the fitting record gives a reason, one within it none;
+    stribeck.seen: a dip velocity at most the fitting record's top speed is one that record could
+    show (reason), a faster one is not (None), and the static level alone (``dip``) is judged at the
+    nominal curve's vs."""
+    from types import SimpleNamespace
+    from hunting.diagnose.causes import stribeck
+    def kin(top):
+        v = -np.linspace(0.1, 1.0, 1000) * top / 0.91      # 90th percentile |v| ~ top
+        return SimpleNamespace(v=v, moving=np.ones(v.size, bool))
+    fit, _, model, _ = _dataset("reporting41", 331)
+    kf = kin(0.004)
+    assert stribeck.top_speed(kf) == pytest.approx(0.004, rel=0.01)
+    assert stribeck.unseen(kf, kin(0.004 * stribeck.UNSEEN_FACTOR * 1.1), model) is not None
+    assert stribeck.unseen(kf, kin(0.004 * stribeck.UNSEEN_FACTOR * 0.9), model) is None
+    assert stribeck.seen({"vs": 0.003, "vs_neg": 0.003}, kf, model) is not None
+    assert stribeck.seen({"vs": 0.003, "vs_neg": 0.006}, kf, model) is None
+    nominal_vs = model.curve.positive.vs
+    assert (stribeck.seen({"dip": True}, kin(2 * nominal_vs), model) is not None
+            and stribeck.seen({"dip": True}, kin(0.5 * nominal_vs), model) is None)
