@@ -94,7 +94,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "fails or cannot be run and the fitting record holds a break-away (the loop's fit then starts from the "
         "readings' where they fit a rising growth at p < {dwell_gate:g}; otherwise from a grid alone, and not beside a "
         "friction-curve cause the force channel found), when the growth fitted on the fitting record's loop cuts that record's "
-        "position error by at least {loop_gain:.0%} and the validation record's by {loop_val_gain:.0%} ({dwell_val_gain:.0%} where the readings suggest a growth at p < {dwell_gate:g}); a break-away excess every rest of both records shows (at least "
+        "position error by at least {loop_gain:.0%} and the validation record's by {loop_val_gain:.0%} ({dwell_fit_gain:.0%} and {dwell_val_gain:.0%} where the readings suggest a growth at p < {dwell_gate:g}); a break-away excess every rest of both records shows (at least "
         "{level_rests} rests, both directions, all above the model's static force and {level_share:.0%} of them by at "
         "least {level_ratio:g} times their reading's error scale): a dwell growth where at least {min_rests} rests "
         "(two per direction) give a rising growth that, fitted on the others beside a level per direction, predicts "
@@ -152,11 +152,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     check_units(kv, model, validate.name)
     from .force import REFERENCE_GAIN, RELEVANCE, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN, LOOP_VALIDATION_GAIN
-    from .causes.dwell_loop import GATE as DWELL_GATE, PROMPTED_VALIDATION_GAIN as DWELL_VAL_GAIN
+    from .causes.dwell_loop import GATE as DWELL_GATE, PROMPTED_FIT_GAIN as DWELL_FIT_GAIN, PROMPTED_VALIDATION_GAIN as DWELL_VAL_GAIN
     from .causes.dwell import GROWTH_SHARE, LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS, MIN_RESTS, SLIDING_WORSE
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN, loop_val_gain=LOOP_VALIDATION_GAIN,
-                      dwell_gate=DWELL_GATE, dwell_val_gain=DWELL_VAL_GAIN, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
+                      dwell_gate=DWELL_GATE, dwell_fit_gain=DWELL_FIT_GAIN, dwell_val_gain=DWELL_VAL_GAIN, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
                       level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE,
                       min_rests=MIN_RESTS + 1, growth_share=GROWTH_SHARE, sliding_worse=SLIDING_WORSE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]

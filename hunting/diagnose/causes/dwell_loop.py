@@ -58,13 +58,19 @@ EVALS = 20           # Nelder-Mead evaluations after the grid
 SIGMA_STEP = 0.05    # half step in log gain and log time of the uncertainty's central differences
 START_STEP = 0.3     # the simplex's steps in log gain and log time of a fit from a start alone
 SCREEN = 0.5         # unprompted: the grid's best must cut the fitting record's error by this share of LOOP_GAIN
-# prompted (the rests suggest a growth, p < GATE): the validation record's cut needed beside LOOP_GAIN on
-# the fitting record. Set on the development sets reporting40-42 (each record's rows of the
-# landed code): of the 77 clean and 61 other-effect records with p < GATE, 10 passed the
-# fitting bar, and their growth cut the validation record's error by at most 11.8 % (reporting40
-# d0618, a resonance beside a growth; clean at most 0.4 %, reporting41 d0016); of the 18 dwell
-# records, reporting41 d0310 (a 20.7 N growth, 57.6 % and 22.5 %) passes it, its gain 9 % off
+# prompted (the rests suggest a growth, p < GATE): the cuts of the fitting and the validation record's
+# position errors needed (unprompted: LOOP_GAIN and LOOP_VALIDATION_GAIN, the bristles' bars).
+# Set on the development sets reporting40-43 (each record's rows of the landed code). The
+# validation bar: of the 77 clean and 61 other-effect records of reporting40-42 with p < GATE, 10
+# cut the fitting record's error by 50 %, and their growth cut the validation record's by at most
+# 11.8 % (reporting40 d0618, a resonance beside a growth; clean at most 0.4 %, reporting41 d0016);
+# reporting41 d0310 (a 20.7 N growth, 57.6 % and 22.5 %) passes it, its gain 9 % off. The fitting
+# bar: the in-sample cut, the validation record's holds out; of the 15 prompted records of
+# reporting40-43 whose growth cut the fitting record's error by 20-50 %, the 4 clean and 5 with
+# other effects failed the validation bar, and three dwell records are named (reporting40 d0588
+# beside its saturation, gain within 1 %; reporting41 d0366, 60 % off; reporting43 d0464, 18 % off)
 PROMPTED_VALIDATION_GAIN = 0.2
+PROMPTED_FIT_GAIN = 0.2
 
 
 def _with(model, gain: float, time: float, sliding: bool | None = None):
@@ -201,8 +207,8 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
     fails): ``loop`` from :func:`refine` or :func:`unprompted`, the growth test's ``p`` (None:
     ``prompt`` says why the loop was asked). Significant when the growth fitted on the fitting
     record's loop cuts its position RMS error by LOOP_GAIN and the validation record's by
-    LOOP_VALIDATION_GAIN, or by PROMPTED_VALIDATION_GAIN where the rests suggest a growth (p <
-    GATE); then its parameters' uncertainties are :func:`sigma`'s where
+    LOOP_VALIDATION_GAIN, or by PROMPTED_FIT_GAIN and PROMPTED_VALIDATION_GAIN where the rests
+    suggest a growth (p < GATE); then its parameters' uncertainties are :func:`sigma`'s where
     ``fit_meas`` (the fitting record) and ``rest_times`` (its rests) are given."""
     from ..resimulate import position_rms_error
     f0, f1 = loop["fit"]
@@ -217,16 +223,18 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
     v0, v1 = position_rms_error(val_meas, model), position_rms_error(val_meas, loop["model"])
     gain_v = relative_fall(v0, v1) if np.isfinite(v0) else -np.inf
     d = loop["model"].dwell
-    bar_v = PROMPTED_VALIDATION_GAIN if p is not None and p < GATE else LOOP_VALIDATION_GAIN
-    ok = gain_f >= LOOP_GAIN and gain_v >= bar_v
+    prompted = p is not None and p < GATE
+    bar_f = PROMPTED_FIT_GAIN if prompted else LOOP_GAIN
+    bar_v = PROMPTED_VALIDATION_GAIN if prompted else LOOP_VALIDATION_GAIN
+    ok = gain_f >= bar_f and gain_v >= bar_v
     if ok:
         asked = f"the rests suggest a growth (p = {p:.2g} < {GATE:g}) and" if p is not None else f"{prompt}, but"
         words = (f"{asked} the loop re-simulated with a growth (fitted on the fitting record's position; "
                  f"{form_words(d)}) follows both records better: position RMS error -{gain_f:.0%} "
-                 f"fitting, -{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {bar_v:.0%} needed)")
-    elif gain_f < LOOP_GAIN:
+                 f"fitting, -{gain_v:.0%} validation (at least {bar_f:.0%} and {bar_v:.0%} needed)")
+    elif gain_f < bar_f:
         words = (f"fitted on the fitting record's loop the growth {cut_words(f0, f1, 'its re-simulated position error')} "
-                 f"({LOOP_GAIN:.0%} needed)")
+                 f"({bar_f:.0%} needed)")
     else:
         cut = cut_words(v0, v1, "the validation record's position error")
         words = (f"fitted on the fitting record's loop ({gain_f:.1%} there) the growth {cut} "
