@@ -152,11 +152,13 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     check_units(kv, model, validate.name)
     from .force import REFERENCE_GAIN, RELEVANCE, SWAP_SHARE
     from .causes.presliding import LOOP_GAIN, LOOP_VALIDATION_GAIN
-    from .causes.dwell_loop import GATE as DWELL_GATE, PROMPTED_FIT_GAIN as DWELL_FIT_GAIN, PROMPTED_VALIDATION_GAIN as DWELL_VAL_GAIN
+    from .causes.dwell_loop import (GATE as DWELL_GATE, PROMPTED_FIT_GAIN as DWELL_FIT_GAIN,
+                                    PROMPTED_VALIDATION_GAIN as DWELL_VAL_GAIN)
     from .causes.dwell import GROWTH_SHARE, LEVEL_RATIO, LEVEL_SHARE, MIN_LEVEL_RESTS, MIN_RESTS, SLIDING_WORSE
     crit = RULE.format(alpha=alpha, min_gain=min_gain, max_causes=max_causes, alpha_reference=alpha_reference,
                       reference_gain=REFERENCE_GAIN * min_gain, loop_gain=LOOP_GAIN, loop_val_gain=LOOP_VALIDATION_GAIN,
-                      dwell_gate=DWELL_GATE, dwell_fit_gain=DWELL_FIT_GAIN, dwell_val_gain=DWELL_VAL_GAIN, swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
+                      dwell_gate=DWELL_GATE, dwell_fit_gain=DWELL_FIT_GAIN, dwell_val_gain=DWELL_VAL_GAIN,
+                      swap_share=SWAP_SHARE, level_rests=MIN_LEVEL_RESTS,
                       level_ratio=LEVEL_RATIO, level_share=LEVEL_SHARE, relevance=RELEVANCE,
                       min_rests=MIN_RESTS + 1, growth_share=GROWTH_SHARE, sliding_worse=SLIDING_WORSE)
     force_names = [n for n in names if getattr(CAUSES[n], "CHANNEL", "force") == "force"]

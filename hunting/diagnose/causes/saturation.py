@@ -74,7 +74,9 @@ def pile_up(u: np.ndarray) -> tuple[float, int, int, int]:
 
 COINCIDE = 1e-9        # [of the maximum] an excursion within this of the maximum reaches it
 REPLICA = 1e-4         # [of the maximum] neighbours of a peak within this of the maximum's: a replica of it
-QUANTIZED = 1e-6       # [of the maximum] an output quantized in steps above twice this is the plateau test's
+QUANTIZED = 1e-6       # [of the maximum] an output quantized in steps above twice this is the plateau test's;
+#                        also the margin of the zone near the extreme beyond its width (the former tolerance,
+#                        kept so that the excursions counted are the same as before)
 
 
 def coinciding_peaks(u: np.ndarray) -> tuple[int, int, float]:
