@@ -1412,3 +1412,21 @@ def test_a_growth_the_rests_suggest_is_named_on_a_smaller_fitting_cut():
     assert [c.name for c in d.causes] == ["dwell"], [(c.name, c.parameters) for c in d.causes]
     assert d.causes[0].parameters["gain"] == pytest.approx(truth["effects"][0]["params"]["gain"], rel=0.25)
     assert "at least 20% and 20% needed" in d.causes[0].gain["evidence"]
+
+
+def test_presliding_stiffness_is_refined_with_its_damping():
+    """reporting44 d0365 (LuGre, sigma0 = 1.02e5 N/m at damping ratio 0.70; creep at rest): the
+    creep fit at the held damping ratio 0.5 read sigma0 35 % high. Refined together with the
+    damping on the fitting record's loop (:func:`presliding.refine_stiffness`), sigma0 comes out
+    within 5 % and the damping ratio within 10 %, and the validation record's position error is
+    no worse than at the admitted fit."""
+    fit, val, model, truth = _dataset("reporting44", 365)
+    true = truth["true"]["plant"]
+    zeta = true["sigma1"] / (2.0 * np.sqrt(true["sigma0"] * model.mass))
+    d = diagnose(fit, model, val, behaviour=False)
+    c = _found(d, "presliding")
+    assert c is not None, [x.name for x in d.causes]
+    assert c.parameters["sigma0"] == pytest.approx(true["sigma0"], rel=0.05)
+    assert c.parameters["zeta"] == pytest.approx(zeta, rel=0.1)
+    assert c.parameters["sigma1"] == pytest.approx(true["sigma1"], rel=0.1)
+    assert c.gain["extended"] < c.gain["nominal"]

@@ -620,14 +620,38 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
     gain = relative_fall(before, after)
     if gain < min_gain:
         return reject(gain, _gain_words(before, after, min_gain, metric))
-    pars = mod.parameters(theta, {}, model)
+    hyper = {}
+    if can_sim and hasattr(mod, "refine_stiffness"):
+        theta, hyper, after, ext = _refined_stiffness(mod, fit, val, model, theta, hyper, after, ext,
+                                                      mod.stiffest(model, fit) / 1.05)
+    pars = mod.parameters(theta, hyper, model)
     sig = {k: None for k in pars}
     if can_sim and hasattr(mod, "log_sigma0_sigma"):
-        sig = parameter_sigma(lambda lg: mod.parameters(np.array([10.0 ** -lg]), {}, model), -np.log10(theta[0]),
-                              mod.log_sigma0_sigma(fit, val, model, theta, segs, mod.segments(kv, model)), 1e-4)
+        sig_lg = (mod.log_sigma0_sigma(fit, val, model, theta, None, None, hyper) if hyper else
+                  mod.log_sigma0_sigma(fit, val, model, theta, segs, mod.segments(kv, model)))
+        sig = parameter_sigma(lambda lg: mod.parameters(np.array([10.0 ** -lg]), hyper, model), -np.log10(theta[0]),
+                              sig_lg, 1e-4)
     return (Cause(mod.NAME, before / max(after, 1e-300) - 1, chi2, p, pars, sig,
-                  dict(metric=metric, nominal=before, extended=after), {}, np.asarray(theta),
+                  dict(metric=metric, nominal=before, extended=after), hyper, np.asarray(theta),
                   family=getattr(mod, "FAMILY", mod.NAME)), None, ext)
+
+
+def _refined_stiffness(mod, fit, val, model, theta, hyper, after, ext, top):
+    """An admitted stick-channel cause's coefficients refined together with its damping
+    (``mod.refine_stiffness`` on the fitting record's loop, up to the stiffness ``top`` [N/m]),
+    kept where the validation record's re-simulated position error (``after`` [m] at the admitted
+    theta) is no worse with them: the admission judged the cause out of sample and the
+    refinement fits the fitting record only. Returns (theta, hyper, after, ext)."""
+    from .resimulate import position_rms_error
+    th, hy, _ = mod.refine_stiffness(fit, model, theta, hyper, top)
+    try:
+        ext_r = mod.extend(model, th, hy)
+    except SystemDefinitionError:
+        return theta, hyper, after, ext
+    after_r = position_rms_error(val, ext_r)
+    if np.isfinite(after_r) and after_r <= after:
+        return th, hy, after_r, ext_r
+    return theta, hyper, after, ext
 
 
 def _loop_channel(mod, fit, val, model, can_sim, test, why):
@@ -648,9 +672,16 @@ def _loop_channel(mod, fit, val, model, can_sim, test, why):
                           reason=f"{why}; and {v['reason']}"), model
     theta, hyper = v["theta"], v.get("hyper", {})
     before, after = v["val"]
+    sig_lg = v.get("sigma_lg")
+    if hasattr(mod, "refine_stiffness"):
+        th0 = theta
+        theta, hyper, after, _ = _refined_stiffness(mod, fit, val, model, theta, hyper, after, None,
+                                                    mod.stiffest(model, fit) / (2.0 * mod.LOOP_STEPS))
+        if theta is not th0:
+            sig_lg = mod.log_sigma0_sigma(fit, val, model, theta, None, None, hyper)
     pars = mod.parameters(theta, hyper, model)
     sig = parameter_sigma(lambda lg: mod.parameters(np.array([10.0 ** -lg]), hyper, model), -np.log10(theta[0]),
-                          v.get("sigma_lg"), 1e-4)
+                          sig_lg, 1e-4)
     return (Cause(mod.NAME, before / max(after, 1e-300) - 1, 1 - v["fit"][1] / v["fit"][0], None, pars, sig,
                   dict(metric="re-simulated position RMS error [m], validation", nominal=before, extended=after,
                        evidence=v["evidence"]), dict(hyper, evidence="loop"), np.asarray(theta),
