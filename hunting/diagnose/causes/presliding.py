@@ -336,11 +336,11 @@ def refine_stiffness(fit, model, theta, hyper: dict, top: float) -> tuple[np.nda
 
     The admission fits sigma0 at a damping ratio it holds (ZETA where the creep shows; one of
     LOOP_ZETAS in the loop evidence), and sigma0 absorbs the damping the data have: on the blind
-    development set reporting44 the 11 presliding records' true damping ratios were 0.31-0.97 and
-    their admitted sigma0 came out -30 % to +35 % off (4 within 10 %); refined, 8 were within
-    10 % (d0323: +34 % -> +10 %, true zeta 0.96 found at 0.98; d0365: +35 % -> +1 %), the
-    validation record's position error fell on 10 of them and rose on d0576 (its caller keeps
-    the admitted fit there). Returns (theta [1 / sigma0], hyper with ``zeta``, the fitting
+    development set reporting44 the 11 records named presliding had true damping ratios of
+    0.31-0.97 and their admitted sigma0 came out -30 % to +35 % off (4 within 10 %); refined, 7
+    were within 10 % (d0323: +34 % -> +10 %, true zeta 0.96 found at 0.98; d0365: +35 % -> +1 %,
+    0.70 at 0.69), none moved out, and the validation record's position error rose on one
+    (d0576, whose caller keeps the admitted fit). Returns (theta [1 / sigma0], hyper with ``zeta``, the fitting
     record's position RMS error [m] there)."""
     from ..resimulate import position_rms_error
     cache = {}
