@@ -585,7 +585,9 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
             rejected.append(dict(name=worst, step="validation", statistic=tests[worst]["t"],
                                  p_value=tests[worst]["p_value"], validation_gain=tests[worst]["gain"],
                                  reason=_why(tests[worst], alpha, min_gain, alpha_reference),
-                                 reference_only=reference_only(tests[worst], alpha, min_gain, alpha_reference)))
+                                 reference_only=reference_only(tests[worst], alpha, min_gain, alpha_reference),
+                                 **_significance_only_row(lib, current, worst, tests[worst], alpha, min_gain,
+                                                          alpha_reference)))
             dropped.add(worst)
             current = _physical_subset(lib, fits, tuple(n for n in current.names if n != worst), rejected)
             current = _next_untried(ranking, dropped, current)
@@ -672,6 +674,26 @@ def reference_only(t: dict, alpha: float, min_gain: float, alpha_reference: floa
     along = ("p_reference", "gain_reference", "gain_reference_set")
     return _fails(t, alpha, min_gain, alpha_reference) and not _fails(
         {k: v for k, v in t.items() if k not in along}, alpha, min_gain, alpha_reference)
+
+
+def significance_only(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:
+    """Whether a member's tests (:func:`_tests`) fail the rule only in the out-of-sample
+    significance (p_value >= alpha; its validation gain and every other test pass): the loop can
+    still judge it at its fitted coefficients (:func:`hunting.diagnose.select._loop_confirmation`)."""
+    return t["p_value"] >= alpha and not _fails(dict(t, p_value=0.0), alpha, min_gain, alpha_reference)
+
+
+def _significance_only_row(lib, current, name: str, t: dict, alpha: float, min_gain: float,
+                           alpha_reference: float) -> dict:
+    """The fields a rejected row gets when its member failed only the significance test
+    (:func:`significance_only`): ``significance_only`` and the member's fitted ``theta`` and
+    ``hyper`` in ``current``; empty otherwise."""
+    if not significance_only(t, alpha, min_gain, alpha_reference):
+        return {}
+    for nm, v, theta in lib._members(current):
+        if nm == name:
+            return dict(significance_only=True, theta=np.array(theta, dtype=float), hyper=dict(v.hyper))
+    return {}
 
 
 def _fails(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:

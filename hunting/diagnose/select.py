@@ -90,7 +90,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "{loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
         "that fitted on the fitting record's loop cuts its position error most, when it cuts both records' by at least "
         "{loop_gain:.0%}; a noise-fed cause that fails only along the reference trajectory, when fitted on the fitting "
-        "record's loop it cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
+        "record's loop it cuts both records' position error by at least {loop_gain:.0%}; a force-channel cause that "
+        "fails only the significance test (its validation gain passes), when the loop re-simulated with it at its fitted "
+        "values cuts both records' position error by at least {loop_gain:.0%}; dwell, where its growth test "
         "fails or cannot be run and the fitting record holds a break-away (the loop's fit then starts from the "
         "readings' where they fit a rising growth at p < {dwell_gate:g}; otherwise from a grid alone, and not beside a "
         "friction-curve cause the force channel found), when the growth fitted on the fitting record's loop cuts that record's "
@@ -236,6 +238,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             fc.update(_loop_force_channel(fit, validate, model, force_names, why, untested))
     if can_sim and fc["nominal"] is not None:
         fc = _loop_admission(fc, fit, validate)
+        fc = _loop_confirmation(fc, fit, validate)
+        fc = _loop_refined(fc, fit, validate, kf)
+    fc = dict(fc, rejected=[{k: v for k, v in r.items() if k not in ("theta", "hyper")} for r in fc["rejected"]])
     ext = fc["model"]
     result, rejected = result + list(fc["causes"]), rejected + list(fc["rejected"])
     for name in stick_names:
@@ -410,6 +415,105 @@ def _loop_admission(fc: dict, fit: Measurement, validate: Measurement) -> dict:
                                                       row["statistic"], row["p_value"])]
     out["model"] = loop_channel.extended(r["key"], fc["model"], r["x"])
     return out
+
+
+def _loop_confirmation(fc: dict, fit: Measurement, validate: Measurement) -> dict:
+    """The force channel's result ``fc`` with the causes that failed only the out-of-sample
+    significance test (``significance_only``: their validation gain passed) judged on the loop at
+    the coefficients the force channel fitted: the force channel's extended model with the cause
+    added, re-simulated, must cut the position RMS error of both records by at least LOOP_GAIN
+    against the extended model without it (the largest cut is taken first, one cause).
+
+    The significance test whitens the validation residual with an AR model fitted on the nominal
+    residual; a lightly damped resonance the model lacks rings in that residual, and the AR model
+    takes the ringing for noise (reporting44 d0419: a 13.9 Hz load at damping 0.025, the validation
+    force residual 25 % smaller with it and p = 0.32; re-simulated with it the loop's position
+    error fell by 98 % on the validation record). No coefficient is fitted on the loop, so both
+    records are out of sample for this evidence."""
+    from .causes.presliding import LOOP_GAIN
+    from .resimulate import position_rms_error
+    rows = [r for r in fc["rejected"] if r.get("significance_only") and "theta" in r]
+    if not rows:
+        return fc
+    base = fc["model"]
+    f0, v0 = position_rms_error(fit, base), position_rms_error(validate, base)
+    if not (np.isfinite(f0) and np.isfinite(v0) and f0 > 0 and v0 > 0):
+        return fc
+    best, cuts = None, {}
+    for row in rows:
+        mod = CAUSES[row["name"]]
+        try:
+            ext = mod.extend(base, row["theta"], row["hyper"])
+        except SystemDefinitionError:
+            continue
+        f1, v1 = position_rms_error(fit, ext), position_rms_error(validate, ext)
+        cuts[id(row)] = (relative_fall(f0, f1), relative_fall(v0, v1))
+        cut = min(cuts[id(row)])
+        if np.isfinite(cut) and cut >= LOOP_GAIN and (best is None or cut > best[0]):
+            best = (cut, row, ext, (f0, f1), (v0, v1))
+    # what the loop found, in the reason of each cause it did not admit
+    fc = dict(fc, rejected=[r if id(r) not in cuts or (best is not None and r is best[1]) else dict(
+        r, reason=(f"{r['reason']}; and on the loop at its fitted values it cuts the position error by "
+                   f"{cuts[id(r)][0]:.1%} fitting and {cuts[id(r)][1]:.1%} validation ({LOOP_GAIN:.0%} on both "
+                   "needed)")) for r in fc["rejected"]])
+    if best is None:
+        return fc
+    cut, row, ext, (f0, f1), (v0, v1) = best
+    mod = CAUSES[row["name"]]
+    pars = mod.parameters(row["theta"], row["hyper"], base)
+    evidence = (f"{row['reason']} on the force residual; the loop re-simulated with it at the force channel's fitted "
+                f"values follows both records better: position RMS error -{relative_fall(f0, f1):.0%} fitting, "
+                f"-{relative_fall(v0, v1):.0%} validation (at least {LOOP_GAIN:.0%} on both needed; nothing fitted on "
+                "the loop)")
+    cause = Cause(row["name"], v0 / max(v1, 1e-300) - 1, cut, None, pars,
+                  {k: None for k in pars}, dict(metric=LOOP_METRIC, nominal=v0, extended=v1, evidence=evidence),
+                  dict(row["hyper"], evidence="loop"), np.asarray(row["theta"]),
+                  family=getattr(mod, "FAMILY", mod.NAME))
+    rejected = [r for r in fc["rejected"] if r is not row]
+    alternatives = [a for a in fc["alternatives"] if a.get("name") != row["name"]]
+    return dict(fc, causes=list(fc["causes"]) + [cause], model=ext, rejected=rejected, alternatives=alternatives)
+
+
+def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinematics) -> dict:
+    """The force channel's result ``fc`` with the named causes that can be refined on the loop
+    (``refine_on_loop``: a resonance's load mass and damping) refitted on the fitting record's
+    re-simulated loop, kept where the validation record's re-simulated position error is no worse
+    with the refined values (the refinement sees the fitting record only). A cause the fitting
+    record (kinematics ``kf``) cannot show (``refinable`` says why: a resonance above its band,
+    too few sliding samples; found on the validation record's blocks) keeps its values
+    (reporting35 d0321: a 26.5 Hz load found on the validation record within 10 %, refitted on a
+    fitting record with fewer than 512 sliding samples 21 % low). The cause's parameters,
+    uncertainties and increments and the extended model then hold the refined values; its gain
+    stays the force channel's evidence, and ``gain["refined_on_loop"]`` gives the validation
+    record's position RMS error at the force channel's values and at the refined ones [m]."""
+    from dataclasses import replace as replace_cause
+    from .resimulate import position_rms_error
+    causes, model = list(fc["causes"]), fc["model"]
+    for k, c in enumerate(causes):
+        mod = CAUSES[c.name]
+        if not hasattr(mod, "refine_on_loop") or c.theta is None or c.hyper.get("evidence") == "loop":
+            continue
+        if mod.refinable(kf, model, c.hyper) is not None:
+            continue
+        before = position_rms_error(validate, model)
+        if not np.isfinite(before):
+            continue
+        theta, hyper, sig = mod.refine_on_loop(fit, model, c.theta, c.hyper)
+        try:
+            ext = mod.extend(model, theta, hyper)
+        except SystemDefinitionError:
+            continue
+        after = position_rms_error(validate, ext)
+        if not (np.isfinite(after) and after <= before):
+            continue
+        pars = mod.parameters(theta, hyper, model)
+        inc = {n: pars[n] - (c.parameters[n] - d) for n, d in c.increments.items() if n in pars}
+        sigma = {n: sig.get(n, c.sigma.get(n)) for n in pars}
+        gain = dict(c.gain, refined_on_loop=dict(metric=LOOP_METRIC, force_channel=before, refined=after))
+        causes[k] = replace_cause(c, parameters=pars, sigma=sigma, increments=inc, theta=np.asarray(theta),
+                                  hyper=hyper, gain=gain)
+        model = ext
+    return dict(fc, causes=causes, model=model)
 
 
 def one_way_offset(result: list, untested: list, model: NominalModel, kin: Kinematics) -> list:
