@@ -498,7 +498,7 @@ def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinemat
         before = position_rms_error(validate, model)
         if not np.isfinite(before):
             continue
-        theta, hyper, sig = mod.refine_on_loop(fit, model, c.theta, c.hyper)
+        theta, hyper, sig = mod.refine_on_loop(fit, model, c.theta, c.hyper, c.sigma)
         try:
             ext = mod.extend(model, theta, hyper)
         except SystemDefinitionError:

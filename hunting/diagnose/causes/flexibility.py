@@ -215,7 +215,7 @@ def refinable(kin, model, hyper) -> str | None:
     return None
 
 
-def refine_on_loop(fit, model, theta, hyper) -> tuple[np.ndarray, dict, dict]:
+def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple[np.ndarray, dict, dict]:
     """The load mass and damping ratio of a named resonance refitted on the fitting record's
     re-simulated loop (whole-record position RMS error; ``model`` the extended model that holds
     the resonance at theta, hyper; the frequency kept): a LOOP_GRID x LOOP_GRID grid of log10 load
@@ -232,7 +232,8 @@ def refine_on_loop(fit, model, theta, hyper) -> tuple[np.ndarray, dict, dict]:
     damping} the larger of each value's within-record uncertainty on the loop
     (:func:`~hunting.diagnose.loop_sigma.coefficient_sigma`, the other held) and its distance to
     the force channel's value over sqrt(2) (two estimates of one value,
-    :func:`~hunting.diagnose.loop_sigma.two_records`)."""
+    :func:`~hunting.diagnose.loop_sigma.two_records`), and the stiffness's from the load mass's
+    and the force channel's frequency uncertainty (``sigma``, the cause's, with ``frequency``)."""
     from ..loop_sigma import coefficient_sigma, two_records
     from ..resimulate import position_rms_error
     m0, z0, f0 = float(theta[0]), float(hyper["damping"]), float(hyper["frequency"])
@@ -264,6 +265,11 @@ def refine_on_loop(fit, model, theta, hyper) -> tuple[np.ndarray, dict, dict]:
         # in decades of log10, then by the delta method in the value's units
         s_lg = two_records(s, np.log10(value), np.log10(start))
         sig[key] = None if s_lg is None else float(value * np.log(10.0) * s_lg)
+    s_f = (sigma or {}).get("frequency")
+    if sig["load_mass"] is not None:
+        # stiffness = m2 (2 pi f)^2: relative uncertainties add in quadrature, the frequency's twice
+        rel_f = 2.0 * s_f / f0 if s_f is not None else 0.0
+        sig["stiffness"] = float(m * (2 * np.pi * f0) ** 2 * np.hypot(sig["load_mass"] / m, rel_f))
     return np.array([m]), dict(hyper, damping=float(z), frequency=f0), sig
 
 
