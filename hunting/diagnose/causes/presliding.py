@@ -340,8 +340,8 @@ def refine_stiffness(fit, model, theta, hyper: dict, top: float) -> tuple[np.nda
     0.31-0.97 and their admitted sigma0 came out -30 % to +35 % off (4 within 10 %); refined, 7
     were within 10 % (d0323: +34 % -> +10 %, true zeta 0.96 found at 0.98; d0365: +35 % -> +1 %,
     0.70 at 0.69), none moved out, and the validation record's position error rose on one
-    (d0576, whose caller keeps the admitted fit). Returns (theta [1 / sigma0], hyper with ``zeta``, the fitting
-    record's position RMS error [m] there)."""
+    (d0576, whose caller keeps the admitted fit). Returns (theta [1 / sigma0], hyper with
+    ``zeta``, the fitting record's position RMS error [m] there)."""
     from ..resimulate import position_rms_error
     cache = {}
 
