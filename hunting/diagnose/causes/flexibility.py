@@ -234,29 +234,17 @@ def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple
     the force channel's value over sqrt(2) (two estimates of one value,
     :func:`~hunting.diagnose.loop_sigma.two_records`), and the stiffness's from the load mass's
     and the force channel's frequency uncertainty (``sigma``, the cause's, with ``frequency``)."""
+    from ..loop_grid import grid_minimum
     from ..loop_sigma import coefficient_sigma, two_records
     from ..resimulate import position_rms_error
     m0, z0, f0 = float(theta[0]), float(hyper["damping"]), float(hyper["frequency"])
     top = 0.98 * model.mass
-    cache = {}
 
     def at(lm, lz):
         return extend(model, np.array([min(m0 * 10.0 ** lm, top)]), dict(hyper, damping=z0 * 10.0 ** lz))
-
-    def cost(lm, lz):
-        key = (round(lm, 9), round(lz, 9))
-        if key not in cache:
-            cache[key] = position_rms_error(fit, at(lm, lz))
-        return cache[key]
     lms = np.linspace(-LOOP_SPAN[0], min(LOOP_SPAN[0], np.log10(top / m0)), LOOP_GRID)
     lzs = np.linspace(-LOOP_SPAN[1], LOOP_SPAN[1], LOOP_GRID)
-    best = min((cost(a, b), a, b) for a in lms for b in lzs)
-    dm, dz = lms[1] - lms[0], lzs[1] - lzs[0]
-    for _ in range(LOOP_ROUNDS):
-        best = min([best] + [(cost(a, b), a, b) for a in np.linspace(best[1] - dm, min(best[1] + dm, lms[-1]), 5)
-                             for b in np.linspace(best[2] - dz, best[2] + dz, 5)])
-        dm, dz = dm / 2, dz / 2
-    _, lm, lz = best
+    _, lm, lz = grid_minimum(lambda a, b: position_rms_error(fit, at(a, b)), lms, lzs, LOOP_ROUNDS)
     m, z = min(m0 * 10.0 ** lm, top), z0 * 10.0 ** lz
     s_lm = coefficient_sigma(fit, lambda x: at(x, lz), lm, LOOP_STEP)
     s_lz = coefficient_sigma(fit, lambda x: at(lm, x), lz, LOOP_STEP)

@@ -342,26 +342,16 @@ def refine_stiffness(fit, model, theta, hyper: dict, top: float) -> tuple[np.nda
     0.70 at 0.69), none moved out, and the validation record's position error rose on one
     (d0576, whose caller keeps the admitted fit). Returns (theta [1 / sigma0], hyper with
     ``zeta``, the fitting record's position RMS error [m] there)."""
+    from ..loop_grid import grid_minimum
     from ..resimulate import position_rms_error
-    cache = {}
 
     def cost(lg, lz):
-        key = (round(lg, 9), round(lz, 9))
-        if key not in cache:
-            ext = extend(model, np.array([10.0 ** -lg]), dict(hyper, zeta=10.0 ** lz))
-            cache[key] = position_rms_error(fit, ext)
-        return cache[key]
+        return position_rms_error(fit, extend(model, np.array([10.0 ** -lg]), dict(hyper, zeta=10.0 ** lz)))
     lg0 = -float(np.log10(theta[0]))
     hi = min(lg0 + REFINE_SPAN, float(np.log10(top)))
     lgs = np.linspace(min(lg0 - REFINE_SPAN, hi - 1e-6), hi, REFINE_GRID[0])
     lzs = np.linspace(np.log10(REFINE_ZETAS[0]), np.log10(REFINE_ZETAS[1]), REFINE_GRID[1])
-    best = min((cost(a, b), a, b) for a in lgs for b in lzs)
-    dl, dz = lgs[1] - lgs[0], lzs[1] - lzs[0]
-    for _ in range(REFINE_ROUNDS):
-        best = min([best] + [(cost(a, b), a, b) for a in np.linspace(best[1] - dl, min(best[1] + dl, hi), 5)
-                             for b in np.clip(np.linspace(best[2] - dz, best[2] + dz, 5), lzs[0], lzs[-1])])
-        dl, dz = dl / 2, dz / 2
-    err, lg, lz = best
+    err, lg, lz = grid_minimum(cost, lgs, lzs, REFINE_ROUNDS, (lzs[0], lzs[-1]))
     return np.array([10.0 ** -lg]), dict(hyper, zeta=float(10.0 ** lz)), float(err)
 
 
