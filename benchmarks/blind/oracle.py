@@ -1,0 +1,216 @@
+"""What hunting's own measures could see of a blind dataset's hidden effects: an oracle that
+knows the truth.
+
+A blind effect is "moderate" by the generator's measure (:mod:`benchmarks.blind.measures`: its
+own inverse dynamics, a 30 Hz Butterworth low pass, every sample above 2 % of the top speed).
+The diagnosis measures differently (a Savitzky-Golay force balance on the samples it trusts, and
+the re-simulated loop), and an effect the generator's measure sees can be below what the
+diagnosis's measures can show at all. This module puts the *true* model, the nominal model
+changed by the true effects with their true parameters (the model JSON the generator writes for
+the nominal plant, written here for the true one), through hunting's own measures:
+
+- ``force_gain``: 1 - RMS(r_true) / RMS(r_nominal) of :func:`hunting.diagnose.kinematics.residual`
+  on the samples the force channel uses (the nominal model's :func:`used_samples`), per record;
+  the force channel cannot name a cause whose exact model does not cut this by its ``min_gain``
+  (5 %) on the validation record;
+- ``loop_gain``: 1 - RMS(q_true - q) / RMS(q_nominal - q) of the loop re-simulated from the
+  measured reference (:func:`hunting.diagnose.resimulate.resimulate`), per record; the loop's
+  evidence needs ``LOOP_GAIN`` (50 %) on both records.
+
+An effect neither measure sees at its bar is out of the diagnosis's reach whatever its selection
+rules: a miss there is an estimation limit, not a selection error. The causes the diagnosis
+judges on evidence of their own (``draw.BEHAVIOUR_CHANNEL``: a dwell growth's break-away
+readings, a saturation's or a DAC's output levels) are counted apart: neither measure is their
+evidence. The oracle judges nothing and is not a judge: it reads the truth, which no judge may.
+
+    python -m benchmarks.blind.oracle /work/wt/blind-data/reporting46 [--jobs 2]
+    python -m benchmarks.blind.oracle /work/wt/blind-data/reporting46 --summary --hunting hunting-<rev>
+
+Results: <set>/../results/<set name>/oracle/dNNNN.json (resumable, like :mod:`.run`)."""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import time
+from dataclasses import fields
+from pathlib import Path
+
+import numpy as np
+
+from . import draw, report
+from .system import Controller, Curve, Plant, Sensor, nominal_json
+
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+FORCE_BAR = 0.05     # the force channel's min_gain
+LOOP_BAR = 0.50      # the loop channel's LOOP_GAIN (on both records)
+
+
+def _plant(d: dict) -> Plant:
+    keys = {f.name for f in fields(Plant)}
+    kw = {k: v for k, v in d.items() if k in keys}
+    kw["pos"], kw["neg"] = Curve(**d["pos"]), Curve(**d["neg"])
+    for k in ("dwell", "flex", "cogging"):
+        if kw.get(k) is not None:
+            kw[k] = tuple(tuple(x) if isinstance(x, list) else x for x in kw[k])
+    return Plant(**kw)
+
+
+def _controller(d: dict) -> Controller:
+    keys = {f.name for f in fields(Controller)}
+    kw = {k: v for k, v in d.items() if k in keys}
+    if kw.get("saturation") is None:
+        kw["saturation"] = math.inf
+    return Controller(**kw)
+
+
+def true_model_json(truth: dict) -> dict:
+    """The model JSON (the schema ``hunting diagnose --model`` reads) of the true system."""
+    return nominal_json(_plant(truth["true"]["plant"]), _controller(truth["true"]["controller"]),
+                        Sensor(**truth["sensor"]))
+
+
+def _rms(x) -> float:
+    x = np.asarray(x, float)
+    return float(np.sqrt(np.mean(x ** 2))) if x.size else float("nan")
+
+
+def measure(dd: Path) -> dict:
+    """The oracle's gains for dataset directory ``dd`` (module docstring): per record ``fit`` and
+    ``val``, force_gain and loop_gain (None where a measure cannot be formed), and the samples
+    the force channel uses."""
+    from hunting.diagnose import NominalModel, load
+    from hunting.diagnose.kinematics import kinematics, residual, used_samples
+    from hunting.diagnose.parts import default_window
+    from hunting.diagnose.resimulate import resimulate
+    truth = json.loads((dd / "truth.json").read_text())
+    fit, val = load(dd / "fit.npz"), load(dd / "val.npz")
+    nominal = NominalModel.from_json(dd / "model.json")
+    true = NominalModel.from_dict(true_model_json(truth))
+    window = default_window(fit, val, nominal)
+    out = {}
+    for name, meas in (("fit", fit), ("val", val)):
+        k = kinematics(meas, nominal.cm, window=window, resolution=nominal.resolution, noise=nominal.sensor_noise,
+                       steady=nominal.steady_slide)
+        used = used_samples(k, nominal)
+        r0, r1 = residual(k, nominal), residual(k, true)
+        ok = used & np.isfinite(r0) & np.isfinite(r1)
+        force = 1 - _rms(r1[ok]) / _rms(r0[ok]) if ok.sum() >= 10 and _rms(r0[ok]) > 0 else None
+        loop = None
+        if nominal.controller is not None and meas.q_ref is not None:
+            s0, s1 = resimulate(meas, nominal), resimulate(meas, true)
+            if s0.ok and s1.ok:
+                e0, e1 = _rms(s0.q - meas.q), _rms(s1.q - meas.q)
+                loop = 1 - e1 / e0 if e0 > 0 else None
+        out[name] = dict(force_gain=force, loop_gain=loop, used=int(ok.sum()))
+    return out
+
+
+def visible(o: dict) -> str:
+    """Which of hunting's measures shows an effect at its bar: "force" (the validation record's
+    force gain >= FORCE_BAR), "loop" (both records' loop gains >= LOOP_BAR), "both", or "neither"."""
+    f = (o["val"]["force_gain"] or -1) >= FORCE_BAR
+    lp = min(o["fit"]["loop_gain"] or -1, o["val"]["loop_gain"] or -1) >= LOOP_BAR
+    return "both" if f and lp else "force" if f else "loop" if lp else "neither"
+
+
+def run(set_dir: Path, jobs: int = 2) -> Path:
+    """Measure every effect dataset of ``set_dir`` (clean ones have no effect to see)."""
+    from concurrent.futures import ProcessPoolExecutor
+    from tqdm import tqdm
+    out = set_dir.parent / "results" / set_dir.name / "oracle"
+    out.mkdir(parents=True, exist_ok=True)
+    todo = [p.parent for p in sorted(set_dir.glob("d[0-9]*/truth.json"))
+            if json.loads(p.read_text())["causes"] and not (out / f"{p.parent.name}.json").is_file()]
+    with ProcessPoolExecutor(max_workers=max(1, min(jobs, 2)), initializer=os.nice, initargs=(10,)) as ex:
+        for dd, res in tqdm(zip(todo, ex.map(_safe, todo)), total=len(todo), desc=f"oracle {set_dir.name}"):
+            (out / f"{dd.name}.json").write_text(json.dumps(res, indent=1))
+    return out
+
+
+def _safe(dd: Path) -> dict:
+    t0 = time.perf_counter()
+    try:
+        res = measure(dd)
+    except Exception as e:                       # one dataset's failure is recorded, not fatal
+        res = dict(error=f"{type(e).__name__}: {e}")
+    return dict(res, seconds=time.perf_counter() - t0)
+
+
+def summary(set_dir: Path, label: str) -> str:
+    """Markdown: the moderate single effects by what the oracle says hunting's measures can show,
+    against whether the judge ``label`` named them first."""
+    truths = report.load_truths(set_dir)
+    res_root = set_dir.parent / "results" / set_dir.name
+    oracle = report.load_results(res_root / "oracle")
+    rows = report.score(truths, report.load_results(res_root / label))
+    lines = [f"Moderate single effects of `{set_dir.name}` by what hunting's own measures show of the exact "
+             f"effect (visible: the validation force gain >= {FORCE_BAR:.0%}, or both records' loop gains >= "
+             f"{LOOP_BAR:.0%}), against `{label}` naming them first. Causes judged on their own evidence "
+             f"({', '.join(draw.BEHAVIOUR_CHANNEL)}) are counted apart.", "",
+             "| cause | n | visible | named first (visible) | invisible | named first (invisible) |",
+             "|---|---|---|---|---|---|"]
+    by = {}
+    misses = []
+    for r in rows:
+        if len(r["causes"]) != 1 or not r["effects"][0]["moderate"] or r["id"] not in oracle:
+            continue
+        o = oracle[r["id"]]
+        if "error" in o:
+            continue
+        e = r["effects"][0]
+        if e["cause"] in draw.BEHAVIOUR_CHANNEL:
+            own = by.setdefault(("own", e["cause"]), [0, 0])
+            own[0] += 1
+            own[1] += e["first"]
+            if not e["first"]:
+                misses.append((r["id"], e["cause"], e["gain"], o, r["reported"]))
+            continue
+        v = visible(o) != "neither"
+        c = by.setdefault(e["cause"], [0, 0, 0, 0])
+        c[0 if v else 2] += 1
+        c[1 if v else 3] += e["first"]
+        if not e["first"]:
+            misses.append((r["id"], e["cause"], e["gain"], o, r["reported"]))
+    tot = [0, 0, 0, 0]
+    for cause in sorted(k for k in by if isinstance(k, str)):
+        c = by[cause]
+        tot = [a + b for a, b in zip(tot, c)]
+        lines.append(f"| {cause} | {c[0] + c[2]} | {c[0]} | {c[1]} | {c[2]} | {c[3]} |")
+    lines.append(f"| force and loop causes | {tot[0] + tot[2]} | {tot[0]} | {tot[1]} | {tot[2]} | {tot[3]} |")
+    own = [by[k] + [k[1]] for k in sorted(k for k in by if not isinstance(k, str))]
+    if own:
+        lines += ["", "Own evidence (named first / n): " + ", ".join(f"{c} {b}/{a}" for a, b, c in own)]
+    lines += ["", "Misses (moderate singles not named first): generator gain; oracle force gain fit / val; loop "
+              "gain fit / val; reported", "", "| dataset | cause | gain | force fit / val | loop fit / val | "
+              "reported |", "|---|---|---|---|---|---|"]
+
+    def f(x):
+        return "-" if x is None else f"{x:+.2f}"
+    for i, cause, g, o, rep in misses:
+        lines.append(f"| {i} | {cause} | {g:.2f} | {f(o['fit']['force_gain'])} / {f(o['val']['force_gain'])} | "
+                     f"{f(o['fit']['loop_gain'])} / {f(o['val']['loop_gain'])} | {', '.join(rep) or 'nothing'} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("set_dir", type=Path)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--summary", action="store_true", help="print the table against --hunting's results")
+    ap.add_argument("--hunting", default=None, help="the judge's result label, e.g. hunting-ddd5d40")
+    a = ap.parse_args(argv)
+    if a.summary:
+        if not a.hunting:
+            ap.error("--summary needs --hunting LABEL")
+        print(summary(a.set_dir, a.hunting), end="")
+        return 0
+    run(a.set_dir, a.jobs)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
