@@ -8,7 +8,10 @@ written as CSV. The command then runs in a fresh process twice with its own empt
 user meets after installing), the second loads the caches. Wall and CPU seconds are reported
 (``--repeat N``: lowest CPU of N cold runs), with the functions that take the compile time.
 
-    python benchmarks/bench_diagnose.py [--repeat 2] [--root DIR]
+    python benchmarks/bench_diagnose.py [--repeat 2] [--root DIR] [--clean]
+
+``--clean``: the same servo without the offset, where the diagnosis names nothing and so runs
+every check it has (since the thirty-sixth session the loop check of a silent force channel).
 
 Measured (2 shared cores, 2026-11-26, main at the method-error change; another process kept
 one core busy, so read the CPU column): see docs/diagnosis.md, "Speed".
@@ -29,11 +32,12 @@ MODEL = ROOT / "examples" / "pd_servo.json"
 DURATION = 20.0      # [s] per record, sampled at the synthetic servo's 1 kHz
 
 
-def records(directory: str) -> tuple[str, str]:
-    """Write the fitting and validation CSV files into ``directory``; returns their paths."""
+def records(directory: str, offset: float = -3.0) -> tuple[str, str]:
+    """Write the fitting and validation CSV files into ``directory`` (the servo with a hidden
+    ``offset`` [N]); returns their paths."""
     from hunting.diagnose.data import save_csv
     from hunting.diagnose.synthetic import TruePlant, generate
-    machine = TruePlant(offset=-3.0)
+    machine = TruePlant(offset=offset)
     paths = []
     for name, seed in (("fit", 1), ("val", 2)):
         meas = generate(machine, DURATION, seed=seed)
@@ -47,9 +51,11 @@ def records(directory: str) -> tuple[str, str]:
 def main() -> None:
     root = Path(_arg("--root", str(ROOT))).resolve()
     repeat = max(1, int(_arg("--repeat", "1")))
-    print(f"hunting from {root}; hunting diagnose on {DURATION:g} s at 1 kHz + validation; lowest CPU of {repeat}")
+    clean = "--clean" in sys.argv
+    print(f"hunting from {root}; hunting diagnose on {DURATION:g} s at 1 kHz + validation "
+          f"({'clean' if clean else 'a hidden 3 N offset'}); lowest CPU of {repeat}")
     with tempfile.TemporaryDirectory() as data:
-        fit, val = records(data)
+        fit, val = records(data, 0.0 if clean else -3.0)
         args = ["diagnose", fit, "--validate", val, "--model", str(MODEL), "--json", os.path.join(data, "d.json")]
         colds = []
         for _ in range(repeat):
