@@ -24,7 +24,8 @@ readings, a saturation's or a DAC's output levels) are counted apart: neither me
 evidence. The oracle judges nothing and is not a judge: it reads the truth, which no judge may.
 
     python -m benchmarks.blind.oracle /work/wt/blind-data/reporting46 [--jobs 2]
-    python -m benchmarks.blind.oracle /work/wt/blind-data/reporting46 --summary --hunting hunting-<rev>
+    python -m benchmarks.blind.oracle /work/wt/blind-data/reporting46 --summary --hunting hunting-<rev> \
+        [--append benchmarks/blind/RESULTS_reporting46.md]
 
 Results: <set>/../results/<set name>/oracle/dNNNN.json (resumable, like :mod:`.run`)."""
 from __future__ import annotations
@@ -202,11 +203,16 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--summary", action="store_true", help="print the table against --hunting's results")
     ap.add_argument("--hunting", default=None, help="the judge's result label, e.g. hunting-ddd5d40")
+    ap.add_argument("--append", type=Path, default=None, help="append the table to this RESULTS file (report.py's)")
     a = ap.parse_args(argv)
     if a.summary:
         if not a.hunting:
             ap.error("--summary needs --hunting LABEL")
-        print(summary(a.set_dir, a.hunting), end="")
+        text = summary(a.set_dir, a.hunting)
+        if a.append is not None:
+            with a.append.open("a") as f:
+                f.write("\n### What hunting's measures show of the exact effects (oracle)\n\n" + text)
+        print(text, end="")
         return 0
     run(a.set_dir, a.jobs)
     return 0

@@ -415,9 +415,6 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=Path(__file__).with_name("RESULTS.md"))
     ap.add_argument("--title", default="Blind benchmark of hunting diagnose")
     ap.add_argument("--note", default="", help="a paragraph under the title (what was run)")
-    ap.add_argument("--oracle", action="store_true",
-                    help="append what hunting's own measures show of the exact effects (benchmarks.blind.oracle, "
-                         "run first) against the hunting run's misses")
     a = ap.parse_args(argv)
     judges = {a.hunting: load_results(results_dir(a.set_dir, a.hunting))}
     pre = a.note + "\n\n" if a.note else ""
@@ -431,11 +428,6 @@ def main(argv=None) -> int:
                f"`{meta['chosen_on']}` set ({meta['rule']}).\n\n")
     fig = a.out.with_name(f"detection_{Path(a.set_dir).name}.png")
     S = write(a.set_dir, judges, a.out, fig, title=a.title, preamble=pre)
-    if a.oracle:
-        from . import oracle
-        with a.out.open("a") as f:
-            f.write("\n### What hunting's measures show of the exact effects (oracle)\n\n"
-                    + oracle.summary(a.set_dir, a.hunting))
     for name, s in S.items():
         for label, v, bar, ok, margin, text in targets(s):
             print(f"{name}: {'PASS' if ok else 'FAIL'} {label}: {_pct(v)} (bar {_pct(bar)}, margin "
