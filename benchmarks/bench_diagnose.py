@@ -11,7 +11,7 @@ user meets after installing), the second loads the caches. Wall and CPU seconds 
     python benchmarks/bench_diagnose.py [--repeat 2] [--root DIR] [--clean]
 
 ``--clean``: the same servo without the offset, where the diagnosis names nothing and so runs
-every check it has (since the thirty-sixth session the loop check of a silent force channel).
+every check it has.
 
 Measured (2 shared cores, 2026-11-26, main at the method-error change; another process kept
 one core busy, so read the CPU column): see docs/diagnosis.md, "Speed".

@@ -1130,7 +1130,7 @@ def test_the_loop_channel_names_only_the_best_candidate_on_the_fitting_record(mo
                 else "level" if m.curve != model.curve else "other")
 
     def run(validation):
-        monkeypatch.setattr(loop_channel, "fit_one", lambda name, meas, m, span, *below: (0.5, fitted[name]))
+        monkeypatch.setattr(loop_channel, "fit_one", lambda name, meas, m, span: (0.5, fitted[name]))
         monkeypatch.setattr(resimulate, "position_rms_error",
                             lambda meas, m: 1.0 if changed(m) is None else validation[changed(m)])
         return loop_channel.judge(fit, val, model, list(fitted))
@@ -1208,43 +1208,6 @@ def test_a_clean_cause_the_reference_check_rejects_stays_rejected_on_the_loop():
     assert d.causes == []
     rows = [r for r in d.rejected if r.get("reference_only") and r["name"] in spans(model, fit)]
     assert rows and all("; and on the loop: " in r["reason"] for r in rows)
-
-
-@pytest.mark.parametrize("family, index, name, key, rel", [("reporting46", 308, "lag", "lag", 0.01),
-                                                            ("reporting45", 415, "stribeck", "Fs", 0.005)])
-def test_a_cause_the_force_channel_cannot_see_is_judged_on_the_loop(family, index, name, key, rel):
-    """reporting46 d0308 (a frictional lag of 38 ms) and reporting45 d0415 (the static level 6 %
-    high on an exponential Stribeck curve): the force channel runs and names nothing (d0415: the
-    exact change cuts the validation force residual on its used samples by 4.9 %), and the start
-    code reported nothing. Judged on the whole records' re-simulated loop, as where the force
-    channel is skipped, the true cause cuts both records' position error by more than LOOP_GAIN
-    (d0415: 82 and 73 %): named, its parameter within ``rel``, the evidence saying why the loop
-    judged it; the force channel's rejection rows of the other causes carry the loop's finding."""
-    from hunting.diagnose.causes.presliding import LOOP_GAIN
-    from hunting.diagnose.select import SILENT_LOOP_WHY
-    fit, val, model, truth = _dataset(family, index)
-    assert truth["causes"] == [name]
-    d = diagnose(fit, model, val, behaviour=False)
-    assert [c.name for c in d.causes] == [name], [(c.name, c.parameters) for c in d.causes]
-    c = d.causes[0]
-    assert c.parameters[key] == pytest.approx(truth["effects"][0]["params"][key], rel=rel)
-    assert c.p_value is None and c.hyper["evidence"] == "loop" and SILENT_LOOP_WHY in c.gain["evidence"]
-    assert 1 - c.gain["extended"] / c.gain["nominal"] >= LOOP_GAIN
-    assert abs(c.parameters[key] - truth["effects"][0]["params"][key]) <= 2 * c.sigma[key]
-    assert name not in {r["name"] for r in d.rejected}
-    assert any("; and " + SILENT_LOOP_WHY in r["reason"] for r in d.rejected), [r["reason"] for r in d.rejected]
-
-
-def test_a_clean_record_whose_force_channel_names_nothing_gets_nothing_from_the_loop():
-    """reporting45 d0058 (clean): the force channel runs and names nothing; on the whole records'
-    loop the best candidate, an offset fitted there, cuts the fitting record's position error by
-    40 %, short of LOOP_GAIN: nothing is named, and the rejections say what the loop found."""
-    from hunting.diagnose.select import SILENT_LOOP_WHY
-    fit, val, model, truth = _dataset("reporting45", 58)
-    assert truth["causes"] == []
-    d = diagnose(fit, model, val, behaviour=False)
-    assert d.nominal is not None and d.causes == []
-    assert any(SILENT_LOOP_WHY in r["reason"] and "50% needed" in r["reason"] for r in d.rejected)
 
 
 def test_a_friction_force_change_below_the_relevance_floor_is_not_a_cause():

@@ -40,7 +40,6 @@ REFINE = 5           # bounded Brent evaluations around the grid's best point
 MAX_DELAY = 0.02     # [s] the largest delay tried
 SIGMA_STEP = 0.01    # the central difference of the fitted coefficient's uncertainty: this share of its span
 MAX_THREADS = min(4, os.cpu_count() or 1)   # threads fitting the candidates side by side
-QUICK_SHARE = 0.5    # quick judgement: only a grid point within this share of LOOP_GAIN is refined
 
 
 def spans(model: NominalModel, meas: Measurement) -> dict:
@@ -126,12 +125,11 @@ def extended(key: str, model: NominalModel, x: float) -> NominalModel | None:
         return None
 
 
-def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple,
-            refine_below: float = np.inf) -> tuple[float, float]:
+def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple) -> tuple[float, float]:
     """(x, error): candidate ``key``'s coefficient minimizing the re-simulated position RMS error [m]
     on ``meas``: a grid of GRID points over ``span`` (the candidate's own in :data:`GRIDS`), then
-    bounded Brent within the best point's neighbours (at most REFINE more re-simulations) where
-    the grid's best error is below ``refine_below`` [m]; error inf where no point re-simulates."""
+    bounded Brent within the best point's neighbours (at most REFINE more re-simulations); error
+    inf where no point re-simulates."""
     from scipy.optimize import minimize_scalar
 
     from .resimulate import position_rms_error
@@ -144,13 +142,11 @@ def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple,
             e = position_rms_error(meas, ext) if ext is not None else np.inf
             cache[x] = e if np.isfinite(e) else np.inf
         return cache[x]
-    grid = GRIDS[key][(GRIDS[key] >= span[0]) & (GRIDS[key] <= span[1])] if key in GRIDS else np.linspace(*span, GRID)
+    grid = GRIDS[key] if key in GRIDS else np.linspace(span[0], span[1], GRID)
     errs = [cost(g) for g in grid]
     k = int(np.argmin(errs))
     if not np.isfinite(errs[k]):
         return float(grid[k]), np.inf
-    if not errs[k] < refine_below:
-        return float(grid[k]), float(errs[k])
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     minimize_scalar(lambda x: min(cost(x), 1e300), bounds=(lo, hi), method="bounded",
                     options=dict(maxiter=REFINE, xatol=1e-4 * (span[1] - span[0])))
@@ -158,13 +154,7 @@ def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple,
     return best, cache[best]
 
 
-# the candidates that lower the static level (their coefficient below zero): held at or above the
-# model's where the force channel ran and named nothing (:func:`judge`'s ``static_not_lower``)
-LOWERING = ("stribeck", "level")
-
-
-def judge(fit: Measurement, val: Measurement, model: NominalModel, names, static_not_lower: bool = False,
-          quick: bool = False) -> dict:
+def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dict:
     """The loop channel's verdict on the force-channel causes ``names`` (those with a one-parameter
     loop extension, :func:`spans`): ``cause`` (name, candidate ``key``, coefficient ``x`` with its
     ``span`` and standard uncertainty ``sigma_x`` (:func:`~hunting.diagnose.loop_sigma.coefficient_sigma`,
@@ -173,29 +163,18 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names, static
     fitting and validation position RMS errors nominal and extended) or None, ``alternatives``
     (the others that pass the bar, same fields), ``rejected`` (name, reason) for the candidates
     tried. A cause with two forms (:data:`FORMS`) is represented by the one that fits the fitting
-    record's loop better. ``static_not_lower``: the candidates of :data:`LOWERING` are fitted at
-    or above the model's static level only. A noise-free re-simulated loop breaks away at the
-    static level, the machine's when its force with the actuator's noise first reaches it, which is
-    earlier: a stick-slip loop's position error then falls at a lower static level whatever the
-    truth (reporting45 d0084, clean: the dip 2.9 % lower cut both records' errors by 87 and 99 %;
-    d0151, clean, LuGre bristles re-simulated at their steady deflection: 28 % lower, 69 and 55 %).
-    Where the force channel judged the sliding samples and found no friction-curve change, a lower
-    static level seen only on the loop is that bias more likely than a cause. ``quick``: a
-    candidate whose grid does not cut the fitting record's error by half the bar is not refined
-    (:data:`QUICK_SHARE`; the check of a silent force channel runs on every clean record)."""
+    record's loop better."""
     from .resimulate import position_rms_error
     f0, v0 = position_rms_error(fit, model), position_rms_error(val, model)
     out = dict(cause=None, alternatives=[], rejected=[])
     if not (np.isfinite(f0) and f0 > 0 and np.isfinite(v0) and v0 > 0):
         out["rejected"] = [dict(name=n, reason="the nominal loop does not re-simulate these records") for n in names]
         return out
-    jobs = [(key, (max(span[0], 0.0), span[1]) if static_not_lower and key in LOWERING else span)
-            for key, span in spans(model, fit).items() if cause_of(key) in names]
+    jobs = [(key, span) for key, span in spans(model, fit).items() if cause_of(key) in names]
     # the candidates' fits are independent and the re-simulation's kernel releases the GIL: on
     # threads they share the machine's cores (the same evaluations, in any order, give the same fits)
     with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), MAX_THREADS))) as pool:
-        below = f0 * (1.0 - QUICK_SHARE * LOOP_GAIN) if quick else np.inf
-        fits = list(pool.map(lambda job: fit_one(job[0], fit, model, job[1], below), jobs))
+        fits = list(pool.map(lambda job: fit_one(job[0], fit, model, job[1]), jobs))
     best: dict = {}
     for (key, span), (x, f1) in zip(jobs, fits):
         name = cause_of(key)

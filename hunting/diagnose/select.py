@@ -87,8 +87,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "model every other channel is judged on its extension, and where it fails there it is judged again last, on "
         "theirs); presliding, where no creep shows at rest, also "
         "when LuGre bristles fitted on the fitting record's re-simulated loop cut that record's position error by at least "
-        "{loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; where too few samples slide for the force balance, or where the force channel names nothing (there "
-        "with static levels not below the model's), the one-parameter force-channel cause "
+        "{loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
         "that fitted on the fitting record's loop cuts its position error most, when it cuts both records' by at least "
         "{loop_gain:.0%}; a noise-fed cause that fails only along the reference trajectory, when fitted on the fitting "
         "record's loop it cuts both records' position error by at least {loop_gain:.0%}; a force-channel cause that "
@@ -127,7 +126,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     bad = [c for c in names if c not in CAUSES]
     if bad:
         raise SystemDefinitionError(f"causes {bad} are not known: use {sorted(CAUSES)}")
-    tick = _Progress(progress, 3 + sum(getattr(CAUSES[n], "CHANNEL", "force") != "force" for n in names))
+    tick = _Progress(progress, 2 + sum(getattr(CAUSES[n], "CHANNEL", "force") != "force" for n in names))
     if not (isinstance(max_causes, (int, np.integer)) and 1 <= max_causes <= 4):
         raise SystemDefinitionError(f"max_causes = {max_causes!r} must be an integer in [1, 4]")
     same = validate is not None and same_record(fit, validate)
@@ -218,7 +217,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         if blocks is not None:          # the fitting record's residual was not part of the fit
             fc = dict(fc, r_fit=nan_f)
             if not fc["causes"] and can_sim:
-                fc = _silent_then_loop(fc, fit, validate, model, force_names, BLOCKS_LOOP_WHY)
+                fc = _blocks_then_loop(fc, fit, validate, model, force_names)
         if not same and split is None and blocks is None:
             fc = validation_only.search(fc, force_names, model, validate, kf, kv, sensor,
                                         window if window_given else None,
@@ -240,9 +239,6 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if can_sim and fc["nominal"] is not None:
         fc = _loop_admission(fc, fit, validate)
         fc = _loop_confirmation(fc, fit, validate)
-        if not fc["causes"] and blocks is None and LOOP_FALLBACK:
-            tick("loop check")
-            fc = _silent_then_loop(fc, fit, validate, model, force_names, SILENT_LOOP_WHY, static_not_lower=True)
         fc = _loop_refined(fc, fit, validate, kf)
     fc = dict(fc, rejected=[{k: v for k, v in r.items() if k not in ("theta", "hyper")} for r in fc["rejected"]])
     ext = fc["model"]
@@ -324,19 +320,17 @@ def _can_simulate(fit: Measurement, validate: Measurement, model: NominalModel) 
 
 
 def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalModel, names, why: str,
-                        untested: list, evidence: str | None = None, static_not_lower: bool = False) -> dict:
+                        untested: list) -> dict:
     """The force channel's part of the result where it was skipped for ``why`` (too few sliding
     samples): the force-channel causes ``names`` judged on the re-simulated loop
     (:func:`hunting.diagnose.loop_channel.judge`) where the loop can be re-simulated; the others go
-    to ``untested``; ``evidence``: why the loop judged them, in a named cause's evidence (default:
-    too few sliding samples); ``static_not_lower``: passed to the loop's judge, with its ``quick``
-    judgement (the check of a silent force channel). Returns the fields
-    of the force channel's result it sets (causes, model, rejected, alternatives)."""
+    to ``untested``. Returns the fields of the force channel's result it sets (causes, model,
+    rejected, alternatives)."""
     from . import loop_channel
     if not _can_simulate(fit, validate, model):
         untested += [dict(name=n, reason=why) for n in names]
         return {}
-    v = loop_channel.judge(fit, validate, model, names, static_not_lower, quick=static_not_lower)
+    v = loop_channel.judge(fit, validate, model, names)
     tried = {r["name"] for r in v["rejected"]} | {r["name"] for r in [v["cause"], *v["alternatives"]] if r}
     untested += [dict(name=n, reason=why) for n in names if n not in tried]
     out = dict(rejected=[dict(name=r["name"], step="loop", statistic=None, p_value=None, validation_gain=None,
@@ -347,11 +341,7 @@ def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalM
                                           nominal=r["val"][0], extended=r["val"][1]))
                            for r in v["alternatives"]]
     r = v["cause"]
-    if r is None:
-        out["causes"] = []
-    else:
-        text = loop_channel.evidence_text(r) if evidence is None else loop_channel.evidence_text(r, evidence)
-        out["causes"] = [_loop_cause(r, model, text, r["gain_fit"], None)]
+    out["causes"] = [] if r is None else [_loop_cause(r, model, loop_channel.evidence_text(r), r["gain_fit"], None)]
     if r is not None:
         out["model"] = loop_channel.extended(r["key"], model, r["x"])
     return out
@@ -375,34 +365,16 @@ def _loop_cause(r: dict, model: NominalModel, evidence: str, statistic, p_value)
 LOOP_METRIC = "re-simulated position RMS error [m], validation"
 
 
-def _silent_then_loop(fc: dict, fit: Measurement, validate: Measurement, model: NominalModel, names,
-                      why: str, static_not_lower: bool = False) -> dict:
-    """The force channel's result ``fc``, which named nothing, with the loop's verdict on the whole
-    records added as where the force channel is skipped (:func:`_loop_force_channel`, its reason
-    ``why``). The force channel judges the sliding samples it trusts; an effect that shows mostly
-    where the loop sticks, breaks away or crawls below the encoder's count can leave them nearly
-    untouched and still move the whole loop: on the validation record's alternate blocks
-    (reporting23 d0513's Stribeck dip, Fs within 1 %, shows only on the loop) and on records whose
-    force channel ran and named nothing (reporting45 d0415: a static level 6 % high on an
-    exponential curve, the exact change cut hunting's validation force residual by 4.9 % and both
-    records' re-simulated position errors by 82 and 73 %). A cause the force channel rejected keeps
-    its row, the loop's finding appended to its reason (its step "loop": the last judge). ``static_not_lower``: where the force channel
-    judged the sliding samples (not the blocks), the loop is not asked for a lower static level
-    (:func:`hunting.diagnose.loop_channel.judge`)."""
-    loop = _loop_force_channel(fit, validate, model, names, why, [], why, static_not_lower)
-    rows = {r["name"]: r for r in fc["rejected"]}
-    rejected = list(fc["rejected"])
-    for r in loop.get("rejected", []):
-        if r["name"] in rows:
-            k = rejected.index(rows[r["name"]])
-            rejected[k] = dict(rows[r["name"]], step="loop", reason=f"{rows[r['name']]['reason']}; and {r['reason']}")
-        else:
-            rejected.append(r)
-    out = dict(fc, rejected=rejected)
+def _blocks_then_loop(fc: dict, fit: Measurement, validate: Measurement, model: NominalModel, names) -> dict:
+    """The force channel's result ``fc`` on the validation record's alternate blocks, where it
+    named nothing, with the loop's verdict on the whole records added as where the force channel is
+    skipped (:func:`_loop_force_channel`): the blocks see little of a record that barely slides,
+    and the loop still does (reporting23 d0513's Stribeck dip, Fs within 1 %, shows only there).
+    The causes the loop does not try were judged on the blocks, so none is marked untested."""
+    loop = _loop_force_channel(fit, validate, model, names, BLOCKS_LOOP_WHY, [])
+    out = dict(fc, rejected=list(fc["rejected"]) + loop.get("rejected", []))
     if loop.get("causes"):
-        found = {c.name for c in loop["causes"]}
-        out.update(causes=loop["causes"], model=loop["model"], alternatives=loop["alternatives"],
-                   rejected=[r for r in rejected if r["name"] not in found])
+        out.update(causes=loop["causes"], model=loop["model"], alternatives=loop["alternatives"])
     return out
 
 
@@ -580,10 +552,6 @@ def worse_resimulation(view: dict) -> list:
 
 BLOCKS_LOOP_WHY = ("too few sliding samples in the fitting data for the force channel on the two records, and nothing "
                    "named on the validation record's alternate blocks")
-SILENT_LOOP_WHY = ("nothing named on the sliding samples the force balance uses (the force channel); judged on the "
-                   "whole records' re-simulated loop, static levels not below the model's")
-# the loop's verdict on records whose force channel ran and named nothing (:func:`_silent_then_loop`)
-LOOP_FALLBACK = True
 OTHER_EVIDENCE_NOTE = ("{name} is named from the {channel} cause's own evidence (its evidence line); on the sliding "
                        "samples (the force channel) it was not selected: {reason}")
 _POOR_FIT = ("the fitting data ({name}) have {n} sliding samples the force channel can use (away from stops, "
