@@ -48,10 +48,12 @@ def verdicts(first: int = 2) -> list[dict]:
     return sorted(out, key=lambda r: r["k"])
 
 
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """Wilson score interval of a binomial rate k/n."""
+def wilson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a binomial rate k/n at confidence ``level``."""
+    from scipy.stats import norm
     if n == 0:
         return (math.nan, math.nan)
+    z = float(norm.ppf(0.5 + level / 2))
     p = k / n
     d = 1 + z * z / n
     c = (p + z * z / (2 * n)) / d

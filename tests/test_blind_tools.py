@@ -1,0 +1,94 @@
+"""The blind benchmark's reading tools: ``history`` (every held-out verdict pooled: Wilson
+intervals, the trend per verdict, one common rate) against scipy's independent computations, and
+``oracle`` (the truth put through hunting's own measures) on records whose answer is known."""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import optimize, stats
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.blind import generate, history, oracle  # noqa: E402
+
+
+def test_history_reads_each_verdicts_headline_counts():
+    """The counts of RESULTS_reporting45.md's targets table (hunting-ddd5d40): named first 126 of
+    140, pairs 10 of 14, false alarms 2 of 300, parameters 214 of 223."""
+    rows = {r["set"]: r for r in history.verdicts()}
+    r = rows["reporting45"]
+    assert r["label"] == "hunting-ddd5d40"
+    assert r["named_first"] == (126, 140) and r["both_found"] == (10, 14)
+    assert r["false_alarm"] == (2, 300) and r["params"] == (214, 223)
+    assert [r["k"] for r in history.verdicts(20)] == sorted(r["k"] for r in history.verdicts(20))
+
+
+@pytest.mark.parametrize("k, n", [(126, 140), (3, 300), (0, 14), (14, 14)])
+def test_wilson_interval_is_scipys(k, n):
+    lo, hi = history.wilson(k, n)
+    ci = stats.binomtest(k, n).proportion_ci(method="wilson")
+    assert lo == pytest.approx(ci.low, abs=1e-12) and hi == pytest.approx(ci.high, abs=1e-12)
+
+
+def test_trend_is_the_binomial_logistic_fit_and_homogeneity_the_contingency_test():
+    """The logit slope against a direct maximum-likelihood fit (Nelder-Mead on the binomial
+    log-likelihood), its standard error against the inverse Hessian at the optimum; the one-rate
+    test against scipy's chi-square test of the 2 x k contingency table."""
+    x = np.arange(20.0, 30.0)
+    n = np.array([140, 135, 150, 142, 138, 144, 146, 139, 141, 137], float)
+    k = np.array([120, 118, 133, 127, 125, 131, 134, 128, 131, 128], float)   # rising from 86 % to 93 %
+    slope, se = history.trend(x, k, n)
+
+    def nll(b):
+        p = 1 / (1 + np.exp(-(b[0] + b[1] * x)))
+        return -np.sum(k * np.log(p) + (n - k) * np.log1p(-p))
+    best = optimize.minimize(nll, [1.0, 0.0], method="Nelder-Mead", options=dict(xatol=1e-10, fatol=1e-12,
+                                                                                   maxiter=20000))
+    assert slope == pytest.approx(best.x[1], abs=1e-5)
+    h = 1e-4
+    hess = np.array([[(nll(best.x + h * (ei + ej)) - nll(best.x + h * (ei - ej)) - nll(best.x - h * (ei - ej))
+                       + nll(best.x - h * (ei + ej))) / (4 * h * h) for ej in np.eye(2)] for ei in np.eye(2)])
+    assert se == pytest.approx(np.sqrt(np.linalg.inv(hess)[1, 1]), rel=1e-3)
+    x2, dof, p = history.homogeneity(k, n)
+    ref = stats.chi2_contingency(np.array([k, n - k]), correction=False)
+    assert x2 == pytest.approx(ref.statistic, rel=1e-10) and dof == ref.dof and p == pytest.approx(ref.pvalue)
+    # the same rate in every verdict: no trend to speak of, one rate not rejected
+    flat_k = np.round(0.9 * n)
+    s0, se0 = history.trend(x, flat_k, n)
+    assert abs(s0) < 2 * se0 and history.homogeneity(flat_k, n)[2] > 0.9
+
+
+def _write(family: str, index: int, directory: Path) -> Path:
+    files, truth, _ = generate.make(family, index)
+    dd = directory / f"d{index:04d}"
+    dd.mkdir()
+    for name in ("fit", "val"):
+        np.savez(dd / f"{name}.npz", **files[name])
+    (dd / "model.json").write_text(json.dumps(files["model"], default=generate._json))
+    (dd / "truth.json").write_text(json.dumps(generate._finite(truth), default=generate._json))
+    return dd
+
+
+def test_the_true_model_of_a_clean_record_is_its_nominal_and_an_effect_is_seen(tmp_path):
+    """A clean record's true system is its nominal one: the oracle's true model JSON equals the
+    nominal model the generator wrote, and both gains are zero. A strong hidden offset (the test
+    family's d0010, the strong half of the size range) is visible to hunting's force residual."""
+    dd = _write("test", 0, tmp_path)
+    truth = json.loads((dd / "truth.json").read_text())
+    assert truth["causes"] == []
+    assert oracle.true_model_json(truth) == json.loads((dd / "model.json").read_text())
+    o = oracle.measure(dd)
+    assert o["val"]["force_gain"] == pytest.approx(0.0, abs=1e-12)
+    assert o["val"]["loop_gain"] == pytest.approx(0.0, abs=1e-12)
+    dd = _write("test", 10, tmp_path)
+    truth = json.loads((dd / "truth.json").read_text())
+    assert truth["causes"] == ["offset"]
+    assert oracle.true_model_json(truth)["plant"]["offset"] == pytest.approx(truth["effects"][0]["params"]["offset"])
+    o = oracle.measure(dd)
+    assert o["val"]["force_gain"] > 0.5 and oracle.visible(o) in ("force", "both")
