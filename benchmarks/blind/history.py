@@ -137,7 +137,8 @@ def figure(rows: list[dict], path: Path, plateau: int | None = None) -> None:
         rate = k / n
         ax.errorbar(x, 100 * rate, yerr=100 * np.abs(ci.T - rate), fmt="o", ms=4, capsize=2, label="held-out verdict")
         pooled = k.sum() / n.sum()
-        ax.axhline(100 * pooled, color="C2", lw=1.0, ls=":", label=f"pooled, all {n.size} verdicts: {100 * pooled:.1f} %")
+        ax.axhline(100 * pooled, color="C2", lw=1.0, ls=":",
+                   label=f"pooled, all {n.size} verdicts: {100 * pooled:.1f} %")
         if plateau is not None and np.any(x >= plateau):
             late = x >= plateau
             pl = k[late].sum() / n[late].sum()

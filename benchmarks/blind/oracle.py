@@ -10,7 +10,9 @@ changed by the true effects with their true parameters (the model JSON the gener
 the nominal plant, written here for the true one), through hunting's own measures:
 
 - ``force_gain``: 1 - RMS(r_true) / RMS(r_nominal) of :func:`hunting.diagnose.kinematics.residual`
-  on the samples the force channel uses (the nominal model's :func:`used_samples`), per record;
+  on the samples the force channel uses (the nominal model's :func:`used_samples`), per record
+  (without the estimation's own error that the force channel subtracts, the nominal loop's
+  residual on its noise-free run: it is common to both residuals and small where applied);
   the force channel cannot name a cause whose exact model does not cut this by its ``min_gain``
   (5 %) on the validation record;
 - ``loop_gain``: 1 - RMS(q_true - q) / RMS(q_nominal - q) of the loop re-simulated from the
@@ -154,37 +156,27 @@ def summary(set_dir: Path, label: str) -> str:
              f"({', '.join(draw.BEHAVIOUR_CHANNEL)}) are counted apart.", "",
              "| cause | n | visible | named first (visible) | invisible | named first (invisible) |",
              "|---|---|---|---|---|---|"]
-    by = {}
-    misses = []
+    by, own, misses = {}, {}, []          # by: [visible, first of them, invisible, first]; own: [n, first]
     for r in rows:
-        if len(r["causes"]) != 1 or not r["effects"][0]["moderate"] or r["id"] not in oracle:
+        if len(r["causes"]) != 1 or not r["effects"][0]["moderate"] or "error" in oracle.get(r["id"], {"error": 1}):
             continue
-        o = oracle[r["id"]]
-        if "error" in o:
-            continue
-        e = r["effects"][0]
-        if e["cause"] in draw.BEHAVIOUR_CHANNEL:
-            own = by.setdefault(("own", e["cause"]), [0, 0])
-            own[0] += 1
-            own[1] += e["first"]
-            if not e["first"]:
-                misses.append((r["id"], e["cause"], e["gain"], o, r["reported"]))
-            continue
-        v = visible(o) != "neither"
-        c = by.setdefault(e["cause"], [0, 0, 0, 0])
-        c[0 if v else 2] += 1
-        c[1 if v else 3] += e["first"]
+        o, e = oracle[r["id"]], r["effects"][0]
         if not e["first"]:
             misses.append((r["id"], e["cause"], e["gain"], o, r["reported"]))
-    tot = [0, 0, 0, 0]
-    for cause in sorted(k for k in by if isinstance(k, str)):
-        c = by[cause]
-        tot = [a + b for a, b in zip(tot, c)]
+        if e["cause"] in draw.BEHAVIOUR_CHANNEL:
+            c = own.setdefault(e["cause"], [0, 0])
+            c[0], c[1] = c[0] + 1, c[1] + e["first"]
+            continue
+        j = 0 if visible(o) != "neither" else 2
+        c = by.setdefault(e["cause"], [0, 0, 0, 0])
+        c[j], c[j + 1] = c[j] + 1, c[j + 1] + e["first"]
+    tot = np.sum(list(by.values()), axis=0, dtype=int) if by else np.zeros(4, int)
+    for cause, c in sorted(by.items()):
         lines.append(f"| {cause} | {c[0] + c[2]} | {c[0]} | {c[1]} | {c[2]} | {c[3]} |")
     lines.append(f"| force and loop causes | {tot[0] + tot[2]} | {tot[0]} | {tot[1]} | {tot[2]} | {tot[3]} |")
-    own = [by[k] + [k[1]] for k in sorted(k for k in by if not isinstance(k, str))]
     if own:
-        lines += ["", "Own evidence (named first / n): " + ", ".join(f"{c} {b}/{a}" for a, b, c in own)]
+        counts = ", ".join(f"{k} {b}/{a}" for k, (a, b) in sorted(own.items()))
+        lines += ["", f"Own evidence (named first / n): {counts}"]
     lines += ["", "Misses (moderate singles not named first): generator gain; oracle force gain fit / val; loop "
               "gain fit / val; reported", "", "| dataset | cause | gain | force fit / val | loop fit / val | "
               "reported |", "|---|---|---|---|---|---|"]
