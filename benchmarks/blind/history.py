@@ -49,16 +49,12 @@ def verdicts(first: int = 2) -> list[dict]:
 
 
 def wilson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
-    """Wilson score interval of a binomial rate k/n at confidence ``level``."""
-    from scipy.stats import norm
+    """Wilson score interval of a binomial rate k/n at confidence ``level`` (scipy's binomtest)."""
+    from scipy.stats import binomtest
     if n == 0:
         return (math.nan, math.nan)
-    z = float(norm.ppf(0.5 + level / 2))
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return (c - h, c + h)
+    ci = binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="wilson")
+    return (float(ci.low), float(ci.high))
 
 
 def trend(x: np.ndarray, k: np.ndarray, n: np.ndarray) -> tuple[float, float]:
@@ -82,13 +78,11 @@ def trend(x: np.ndarray, k: np.ndarray, n: np.ndarray) -> tuple[float, float]:
 
 
 def homogeneity(k: np.ndarray, n: np.ndarray) -> tuple[float, int, float]:
-    """(chi-square, degrees of freedom, p) of the hypothesis that every verdict has the pooled rate."""
-    from scipy.stats import chi2
-    p = k.sum() / n.sum()
-    e1, e0 = n * p, n * (1 - p)
-    x2 = float(np.sum((k - e1) ** 2 / e1 + ((n - k) - e0) ** 2 / e0))
-    dof = int(k.size - 1)
-    return x2, dof, float(chi2.sf(x2, dof))
+    """(chi-square, degrees of freedom, p) of the hypothesis that every verdict has the pooled rate
+    (scipy's test of the 2 x verdicts contingency table, no continuity correction)."""
+    from scipy.stats import chi2_contingency
+    r = chi2_contingency(np.array([k, n - k], float), correction=False)
+    return float(r.statistic), int(r.dof), float(r.pvalue)
 
 
 def markdown(rows: list[dict]) -> str:
