@@ -81,35 +81,56 @@ def _rms(x) -> float:
     return float(np.sqrt(np.mean(x ** 2))) if x.size else float("nan")
 
 
-def measure(dd: Path) -> dict:
-    """The oracle's gains for dataset directory ``dd`` (module docstring): per record ``fit`` and
-    ``val``, force_gain and loop_gain (None where a measure cannot be formed), and the samples
-    the force channel uses."""
-    from hunting.diagnose import NominalModel, load
+def _gains(meas, nominal, base, model, window) -> dict:
+    """``model``'s gains over ``base`` on one record: force_gain on the samples the force channel
+    uses (``nominal``'s :func:`used_samples`), loop_gain of the loop re-simulated from the measured
+    reference (None where a measure cannot be formed), and the number of samples used."""
     from hunting.diagnose.kinematics import kinematics, residual, used_samples
-    from hunting.diagnose.parts import default_window
     from hunting.diagnose.resimulate import resimulate
+    k = kinematics(meas, nominal.cm, window=window, resolution=nominal.resolution, noise=nominal.sensor_noise,
+                   steady=nominal.steady_slide)
+    used = used_samples(k, nominal)
+    r0, r1 = residual(k, base), residual(k, model)
+    ok = used & np.isfinite(r0) & np.isfinite(r1)
+    force = 1 - _rms(r1[ok]) / _rms(r0[ok]) if ok.sum() >= 10 and _rms(r0[ok]) > 0 else None
+    loop = None
+    if nominal.controller is not None and meas.q_ref is not None:
+        s0, s1 = resimulate(meas, base), resimulate(meas, model)
+        if s0.ok and s1.ok:
+            e0, e1 = _rms(s0.q - meas.q), _rms(s1.q - meas.q)
+            loop = 1 - e1 / e0 if e0 > 0 else None
+    return dict(force_gain=force, loop_gain=loop, used=int(ok.sum()))
+
+
+def _records(dd: Path):
+    from hunting.diagnose import NominalModel, load
+    from hunting.diagnose.parts import default_window
     truth = json.loads((dd / "truth.json").read_text())
     fit, val = load(dd / "fit.npz"), load(dd / "val.npz")
     nominal = NominalModel.from_json(dd / "model.json")
     true = NominalModel.from_dict(true_model_json(truth))
-    window = default_window(fit, val, nominal)
-    out = {}
-    for name, meas in (("fit", fit), ("val", val)):
-        k = kinematics(meas, nominal.cm, window=window, resolution=nominal.resolution, noise=nominal.sensor_noise,
-                       steady=nominal.steady_slide)
-        used = used_samples(k, nominal)
-        r0, r1 = residual(k, nominal), residual(k, true)
-        ok = used & np.isfinite(r0) & np.isfinite(r1)
-        force = 1 - _rms(r1[ok]) / _rms(r0[ok]) if ok.sum() >= 10 and _rms(r0[ok]) > 0 else None
-        loop = None
-        if nominal.controller is not None and meas.q_ref is not None:
-            s0, s1 = resimulate(meas, nominal), resimulate(meas, true)
-            if s0.ok and s1.ok:
-                e0, e1 = _rms(s0.q - meas.q), _rms(s1.q - meas.q)
-                loop = 1 - e1 / e0 if e0 > 0 else None
-        out[name] = dict(force_gain=force, loop_gain=loop, used=int(ok.sum()))
-    return out
+    return truth, {"fit": fit, "val": val}, nominal, true, default_window(fit, val, nominal)
+
+
+def measure(dd: Path) -> dict:
+    """The oracle's gains for dataset directory ``dd`` (module docstring): per record ``fit`` and
+    ``val``, the true model's force_gain and loop_gain over the nominal model (None where a
+    measure cannot be formed), and the samples the force channel uses."""
+    _, recs, nominal, true, window = _records(dd)
+    return {name: _gains(meas, nominal, nominal, true, window) for name, meas in recs.items()}
+
+
+def rival(dd: Path, result: dict) -> dict:
+    """The true model's gains over the explanation a judge reported (``result``: its result
+    record with the ``extended_model`` it reported; the nominal model where it named nothing),
+    per record, as :func:`measure`'s: where the truth is not :func:`visible` over it by the bars
+    it needs over the nominal model, the data do not tell the reported explanation from the
+    truth (the miss is a confusion the records cannot resolve, not a selection error)."""
+    from hunting.diagnose import NominalModel
+    _, recs, nominal, true, window = _records(dd)
+    ext = result.get("extended_model")
+    base = NominalModel.from_dict(ext) if ext else nominal
+    return {name: _gains(meas, nominal, base, true, window) for name, meas in recs.items()}
 
 
 def visible(o: dict) -> str:
@@ -132,6 +153,50 @@ def run(set_dir: Path, jobs: int = 2) -> Path:
         for dd, res in tqdm(zip(todo, ex.map(_safe, todo)), total=len(todo), desc=f"oracle {set_dir.name}"):
             (out / f"{dd.name}.json").write_text(json.dumps(res, indent=1))
     return out
+
+
+def misses(set_dir: Path, label: str) -> list:
+    """Ids of the moderate effect datasets the judge ``label`` missed: single effects not named
+    first, pairs of moderate effects not both found (report.py's rates)."""
+    truths = report.load_truths(set_dir)
+    rows = report.score(truths, report.load_results(set_dir.parent / "results" / set_dir.name / label))
+    return [r["id"] for r in rows if all(e["moderate"] for e in r["effects"]) and r["effects"] and (
+        not r["effects"][0]["first"] if len(r["effects"]) == 1 else not all(e["found"] for e in r["effects"]))]
+
+
+def run_rival(set_dir: Path, label: str, jobs: int = 2) -> Path:
+    """:func:`rival` on every miss of the judge ``label`` (:func:`misses`). A result record without
+    its extended model (written before run.py kept it) is judged again by the current code, and
+    the rival record says whether that named the same causes."""
+    from concurrent.futures import ProcessPoolExecutor
+    from tqdm import tqdm
+    res_dir = set_dir.parent / "results" / set_dir.name
+    out = res_dir / "rival" / label
+    out.mkdir(parents=True, exist_ok=True)
+    todo = [(set_dir / i, res_dir / label / f"{i}.json") for i in misses(set_dir, label)
+            if not (out / f"{i}.json").is_file()]
+    with ProcessPoolExecutor(max_workers=max(1, min(jobs, 2)), initializer=os.nice, initargs=(10,)) as ex:
+        for (dd, _), res in tqdm(zip(todo, ex.map(_safe_rival, todo)), total=len(todo), desc=f"rival {label}"):
+            (out / f"{dd.name}.json").write_text(json.dumps(res, indent=1))
+    return out
+
+
+def _safe_rival(args) -> dict:
+    dd, result_path = args
+    t0 = time.perf_counter()
+    try:
+        result = json.loads(Path(result_path).read_text())
+        extra = {}
+        if "extended_model" not in result:
+            from .run import judge_hunting
+            again = judge_hunting(dd)
+            extra = dict(judged_again=True, same_causes=[c["name"] for c in again["causes"]]
+                         == [c["name"] for c in result["causes"]])
+            result = dict(result, extended_model=again["extended_model"])
+        res = dict(rival(dd, result), **extra)
+    except Exception as e:                       # one dataset's failure is recorded, not fatal
+        res = dict(error=f"{type(e).__name__}: {e}")
+    return dict(res, seconds=time.perf_counter() - t0)
 
 
 def _safe(dd: Path) -> dict:
@@ -189,6 +254,74 @@ def summary(set_dir: Path, label: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+CLASSES = ("found, not first", "invisible", "confusable", "resolvable", "unmeasured")
+
+
+def classify(row: dict, o: dict | None, rv: dict | None) -> str:
+    """Why a moderate miss (a report.score ``row``) was missed: "found, not first" (a single
+    effect's cause reported after another), "invisible" (the exact effect not :func:`visible`
+    over the nominal model: ``o``, :func:`measure`'s record), "confusable" (the exact effect not
+    visible over the explanation the judge reported: ``rv``, :func:`rival`'s record; the records
+    cannot tell the two apart), "resolvable" (the truth visible over what was reported:
+    the records resolve it and the judge chose otherwise) or "unmeasured" (no rival record)."""
+    if len(row["effects"]) == 1 and row["effects"][0]["found"]:
+        return "found, not first"
+    if rv is None or "error" in rv:
+        return "unmeasured"
+    if o is not None and "error" not in o and visible(o) == "neither":
+        return "invisible"
+    return "confusable" if visible(rv) == "neither" else "resolvable"
+
+
+def miss_table(set_dir: Path, label: str) -> tuple[str, dict]:
+    """(markdown, counts): every moderate miss of the judge ``label`` (:func:`misses`) by
+    :func:`classify`, and the rates over the effects the records resolve (the moderate ones less
+    the invisible and confusable misses). counts: {"single": {class: n, "n": moderate singles,
+    "first": named first}, "pairs": {class: n, "n": moderate pairs, "both": both found}}."""
+    truths = report.load_truths(set_dir)
+    res_root = set_dir.parent / "results" / set_dir.name
+    oracle = report.load_results(res_root / "oracle")
+    rivals = report.load_results(res_root / "rival" / label)
+    rows = report.score(truths, report.load_results(res_root / label))
+    counts = {"single": dict.fromkeys(CLASSES, 0), "pairs": dict.fromkeys(CLASSES, 0)}
+    lines = [f"Moderate misses of `{label}` on `{set_dir.name}` by what separates the truth from what was reported: "
+             f"the exact effect's gains over the nominal model (invisible: below the bars, validation force gain "
+             f"{FORCE_BAR:.0%} or both records' loop gains {LOOP_BAR:.0%}) and over the judge's reported explanation "
+             f"(confusable: below the same bars, the records cannot tell the two apart; resolvable: above them, the records resolve the truth better than the report, by its causes or its values).",
+             "", "| dataset | truth | reported | class | truth over reported: force fit / val | loop fit / val | "
+             "judged again |", "|---|---|---|---|---|---|---|"]
+
+    def f(x):
+        return "-" if x is None else f"{x:+.2f}"
+    for r in rows:
+        if not r["effects"] or not all(e["moderate"] for e in r["effects"]):
+            continue
+        kind = "single" if len(r["effects"]) == 1 else "pairs"
+        c = counts[kind]
+        c["n"] = c.get("n", 0) + 1
+        ok = r["effects"][0]["first"] if kind == "single" else all(e["found"] for e in r["effects"])
+        c["hit"] = c.get("hit", 0) + ok
+        if ok:
+            continue
+        rv = rivals.get(r["id"])
+        cls = classify(r, oracle.get(r["id"]), rv)
+        c[cls] += 1
+        g = rv if rv is not None and "error" not in rv else {"fit": {}, "val": {}}
+        again = "" if rv is None or "judged_again" not in rv else ("same causes" if rv["same_causes"] else "other causes")
+        lines.append(f"| {r['id']} | {', '.join(r['causes'])} | {', '.join(r['reported']) or 'nothing'} | {cls} | "
+                     f"{f(g['fit'].get('force_gain'))} / {f(g['val'].get('force_gain'))} | "
+                     f"{f(g['fit'].get('loop_gain'))} / {f(g['val'].get('loop_gain'))} | {again} |")
+    lines += ["", "| | n | hit | " + " | ".join(CLASSES) + " | hit rate where resolved |",
+              "|---|---|---|" + "---|" * len(CLASSES) + "---|"]
+    for kind, c in counts.items():
+        n, hit = c.get("n", 0), c.get("hit", 0)
+        resolved = n - c["invisible"] - c["confusable"]
+        rate = f"{hit / resolved:.1%} ({hit}/{resolved})" if resolved else "-"
+        name = "singles named first" if kind == "single" else "pairs both found"
+        lines.append(f"| {name} | {n} | {hit} | " + " | ".join(str(c[k]) for k in CLASSES) + f" | {rate} |")
+    return "\n".join(lines) + "\n", counts
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("set_dir", type=Path)
@@ -196,6 +329,8 @@ def main(argv=None) -> int:
     ap.add_argument("--summary", action="store_true", help="print the table against --hunting's results")
     ap.add_argument("--hunting", default=None, help="the judge's result label, e.g. hunting-ddd5d40")
     ap.add_argument("--append", type=Path, default=None, help="append the table to this RESULTS file (report.py's)")
+    ap.add_argument("--rival", default=None, metavar="LABEL",
+                    help="measure the truth over the explanations the judge LABEL reported on its misses")
     a = ap.parse_args(argv)
     if a.summary:
         if not a.hunting:
@@ -204,6 +339,14 @@ def main(argv=None) -> int:
         if a.append is not None:
             with a.append.open("a") as f:
                 f.write("\n### What hunting's measures show of the exact effects (oracle)\n\n" + text)
+        print(text, end="")
+        return 0
+    if a.rival:
+        run_rival(a.set_dir, a.rival, a.jobs)
+        text = miss_table(a.set_dir, a.rival)[0]
+        if a.append is not None:
+            with a.append.open("a") as f:
+                f.write("\n### Why the moderate misses were missed (oracle over the reported explanations)\n\n" + text)
         print(text, end="")
         return 0
     run(a.set_dir, a.jobs)

@@ -43,7 +43,7 @@ def hunting_label() -> str:
 def judge_hunting(dd: Path) -> dict:
     """The diagnosis on one dataset directory: selected causes in rank order with their
     parameters, their standard uncertainties (``sigma``; a parameter without one is left out), p-value, score and validation gain (the metric without and with the cause), the
-    alternatives' names, notes, and the rejected causes' names with their reasons (what a later
+    alternatives' names, notes, the rejected causes' names with their reasons and the extended model (what a later
     look at a miss needs, without running the diagnosis again)."""
     from hunting.diagnose import NominalModel, diagnose, load
     fit, val = load(dd / "fit.npz"), load(dd / "val.npz")
@@ -57,7 +57,8 @@ def judge_hunting(dd: Path) -> dict:
                              gain=c.get("gain")) for c in selected],
                 alternatives=alts, notes=d.get("notes", []), gain=d.get("gain"),
                 rejected=[dict(name=r.get("name"), reason=r.get("reason")) for r in d.get("rejected", []) or []],
-                untested=[dict(name=u.get("name"), reason=u.get("reason")) for u in d.get("untested", []) or []])
+                untested=[dict(name=u.get("name"), reason=u.get("reason")) for u in d.get("untested", []) or []],
+                extended_model=d.get("extended_model"))
 
 
 def judge_peer(dd: Path) -> dict:
