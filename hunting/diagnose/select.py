@@ -103,7 +103,9 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "each rest's excess to at most {growth_share:g} times the error of a level per direction alone; else a static "
         "level higher by it (stribeck), or a dwell growth from Fs fitted on the rests where the force channel found "
         "a friction-curve cause or where that static level makes the force residual on the sliding samples of both "
-        "records at least {sliding_worse:.0%} larger")
+        "records at least {sliding_worse:.0%} larger, or a dwell growth from Fs fitted on the fitting record's loop "
+        "where it cuts the static level's re-simulated position error by at least {loop_gain:.0%} on that record and "
+        "{loop_val_gain:.0%} on the validation record (the loop's short stops break away near Fs under a growth)")
 CRITERION = RULE
 
 
