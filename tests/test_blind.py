@@ -353,17 +353,28 @@ def test_recorded_signal_causes_are_judged_before_the_loop_fits(tmp_path, index,
 
 
 @pytest.mark.parametrize("family, index, expected", [("reporting47", 324, "dwell"), ("reporting46", 513, "stribeck")])
-def test_the_loop_tells_a_dwell_growth_from_a_higher_static_level(tmp_path, family, index, expected):
-    """Records whose rests all outlast their break-away excess's growth (development sets since).
-    reporting47 d0324: a 3.68 N growth complete in 0.094 s over Fs 9.46 N, every rest 0.35-2.66 s,
-    was named a static level 3.62 N higher; its short stops break away near Fs, which the loop
-    re-simulated with the growth follows (the truth cuts that reading's position error by 91 and
-    94 %): dwell first, its gain within 10 %, the static level its alternative. reporting46 d0513:
-    a true Stribeck level 2.6 N higher, rests of 17-337 ms, stays a static level."""
+def test_the_loop_tells_a_dwell_growth_from_a_higher_static_level(tmp_path, monkeypatch, family, index, expected):
+    """Records whose rests all outlast their break-away excess's growth (development sets since),
+    where the loop is asked which of the two readings holds. reporting47 d0324: a 3.68 N growth
+    complete in 0.094 s over Fs 9.46 N, every rest 0.35-2.66 s, was named a static level 3.62 N
+    higher; its short stops break away near Fs, which the loop re-simulated with the growth
+    follows (the truth cuts that reading's position error by 91 and 94 %): dwell first, its gain
+    within 10 %, the static level its alternative. reporting46 d0513: a true Stribeck level
+    2.6 N higher, rests of 17-337 ms: the loop asked too, and the static level kept."""
+    from hunting.diagnose.causes import dwell_loop
+    asked = []
+    real = dwell_loop.static_contradiction
+
+    def counted(level, *args):
+        out = real(level, *args)
+        asked.append("instead" not in out)
+        return out
+    monkeypatch.setattr(dwell_loop, "static_contradiction", counted)
     generate.write(family, tmp_path, indices=[index], progress=False)
     dd = tmp_path / f"d{index:04d}"
     r = run.judge_hunting(dd)
     assert [c["name"] for c in r["causes"]][:1] == [expected], r["causes"]
+    assert asked == [expected == "dwell"]         # asked once; the loop contradicted the static level or not
     if expected == "dwell":
         truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
         assert r["causes"][0]["parameters"]["gain"] == pytest.approx(truth["gain"], rel=0.1)

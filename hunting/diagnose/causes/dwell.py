@@ -348,7 +348,7 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     if level is not None and "instead" in level:
         level = sliding_contradiction(level, model, kf, kv)
     if level is not None and "instead" in level and can_sim:
-        level = dwell_loop.static_contradiction(level, fit, validate, model, t_all)
+        level = dwell_loop.static_contradiction(level, fit, validate, model, t_all, F_all, s_all)
     if level is not None:
         return dict(out, otherwise=level)
     if loop is None and can_sim:
@@ -501,7 +501,7 @@ def level_verdict(t, F, s, scale, model, speeds=None) -> dict | None:
     ext = model.replace(dwell=Dwell(base.level, base.gain + g, tau, base.sliding))
     d = ext.dwell
     evidence = f"{above}; no growth with the rest resolved (rests of {t.min():.3g}-{t.max():.3g} s)"
-    return dict(statistic=ratio, p_value=None, significant=True, rivals=("stribeck",),
+    return dict(statistic=ratio, p_value=None, significant=True, rivals=("stribeck",), seen=evidence,
                 evidence=(f"{evidence}: a growth from the break-away force Fs, its time the one that predicts each "
                           "rest from the others best"),
                 parameters={"level": d.level, "gain": d.gain, "time": d.time},

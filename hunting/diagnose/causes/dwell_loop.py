@@ -250,46 +250,57 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
                 nominal=float(v0), extended=float(v1) if np.isfinite(v1) else float(v0), model=loop["model"])
 
 
-def static_contradiction(level: dict, fit_meas, val_meas, model, rest_times) -> dict:
-    """The break-away level verdict ``level`` (:func:`hunting.diagnose.causes.dwell.level_verdict`,
-    its static-level reading ``instead`` about to be named) with the dwell reading named and the
-    static level its alternative (``also``) where the loop contradicts the static level; else
-    ``level`` unchanged.
+def static_contradiction(level: dict, fit_meas, val_meas, model, t, F, s) -> dict:
+    """The break-away level verdict ``level`` (:func:`hunting.diagnose.causes.dwell.level_verdict`
+    with its two readings, the dwell growth and the static level ``instead``) with the dwell
+    reading's parameters fitted on the loop and the static level as its alternative (``also``)
+    where the loop contradicts the static level; else ``level`` unchanged.
 
     Where every rest outlasts the growth, the break-away readings cannot tell a higher static
     level from a dwell growth, and the static level, the reading with nothing unseen in it, is
-    named. The loop can tell them apart: its short stops (a reversal, a hunting cycle's sticks,
-    too short to read a break-away from) break away near Fs under a growth and at the raised
-    level under the static reading. The growth is fitted on the fitting record's re-simulated
-    position (:func:`fit`: from the rests' fit, its time grid from SHORT_STOP samples to twice
-    the longest rest ``rest_times`` (m,) [s]) and named where it cuts the static reading's
-    position error by LOOP_GAIN on the fitting record and LOOP_VALIDATION_GAIN on the validation
-    record (the bristles' and the unprompted growth's bars). reporting47 d0324: rests of
-    0.35-2.66 s, a 3.68 N growth complete in 0.094 s read as Fs 3.62 N higher; the true growth
-    re-simulates the two records with 91 and 94 % less position error than that reading."""
+    named (unless the force channel found a friction-curve cause: then the dwell reading, and
+    this only changes its parameters). The loop can tell them apart: its short stops (a reversal,
+    a hunting cycle's sticks, too short to read a break-away from) break away near Fs under a
+    growth and at the raised level under the static reading. The growth is fitted on the fitting
+    record's re-simulated position (:func:`fit`: from the rests' fit, its time grid from
+    SHORT_STOP samples to twice the longest rest of both records, t (m,) [s]) and taken where it
+    cuts the static reading's position error by LOOP_GAIN on the fitting record and
+    LOOP_VALIDATION_GAIN on the validation record (the bristles' and the unprompted growth's
+    bars) and follows the validation record better than the nominal model. Its metric stays the
+    level verdict's: the break-away excess of every rest of both records (t, F, s: none of them
+    in the loop's fit), as :func:`hunting.diagnose.causes.dwell._loop_growth` has it.
+
+    reporting47 d0324: rests of 0.35-2.66 s, a 3.68 N growth complete in 0.094 s read as Fs 3.62 N
+    higher; the true growth re-simulates the two records with 91 and 94 % less position error
+    than that reading. On curves without a dip the static reading's Stribeck velocity is an upper
+    bound below the sliding speeds (:func:`hunting.diagnose.causes.dwell.static_reading`): there
+    reporting47 d0478's growth is named and the true static levels of reporting46 d0513 and d0556
+    are kept."""
     from ..resimulate import position_rms_error
+    from .dwell import excess
     static = level["instead"]
     f_s, v_s = position_rms_error(fit_meas, static["model"]), position_rms_error(val_meas, static["model"])
-    t = np.asarray(rest_times, float)
-    if not (np.isfinite(f_s) and np.isfinite(v_s) and f_s > 0 and t.size):
+    if not (np.isfinite(f_s) and np.isfinite(v_s) and f_s > 0):
         return level
-    times = np.concatenate([[SHORT_STOP * fit_meas.dt], t])
+    times = np.concatenate([[2 * SHORT_STOP * fit_meas.dt], np.asarray(t, float)])   # fit's grid starts at half the shortest
     d = level["model"].dwell
     ext, f_g = fit(fit_meas, model, times, start=(d.gain, d.time))
     if ext.dwell is None or not np.isfinite(f_g):
         return level
     v_g = position_rms_error(val_meas, ext)
     gain_f, gain_v = relative_fall(f_s, f_g), relative_fall(v_s, v_g)
-    if not (gain_f >= LOOP_GAIN and gain_v >= LOOP_VALIDATION_GAIN):
+    if not (gain_f >= LOOP_GAIN and gain_v >= LOOP_VALIDATION_GAIN and v_g < position_rms_error(val_meas, model)):
         return level
     g = ext.dwell
     why = (f"the loop re-simulated with a growth from Fs (fitted on the fitting record's position; {form_words(g)}) "
            f"follows both records better than with the static level raised: position RMS error -{gain_f:.0%} fitting, "
            f"-{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} needed)")
     named = {k: v for k, v in level.items() if k != "instead"}
+    e1 = excess(ext, t, F, s)
     return dict(named, model=ext, parameters={"level": g.level, "gain": g.gain, "time": g.time},
                 sigma=sigma(ext, fit_meas, val_meas, model, times), fitted_on="loop",
-                evidence=f"{level['evidence']}; but {why}",
-                metric="re-simulated position RMS error [m], validation",
-                nominal=float(position_rms_error(val_meas, model)), extended=float(v_g),
+                evidence=f"{level['seen']}; but {why}: a growth from the break-away force Fs, its gain and time fitted there",
+                metric=(f"break-away force RMS error [N], the {t.size} rests of both records (the growth fitted on the "
+                        "fitting record's loop)"),
+                extended=float(np.sqrt(np.mean(e1 ** 2))),
                 also=dict(static, evidence=f"{static['evidence']}; but {why}"))
