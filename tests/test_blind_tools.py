@@ -101,3 +101,40 @@ def test_the_true_model_of_a_clean_record_is_its_nominal_and_an_effect_is_seen(t
     assert oracle.true_model_json(truth)["plant"]["offset"] == pytest.approx(truth["effects"][0]["params"]["offset"])
     o = oracle.measure(dd)
     assert o["val"]["force_gain"] > 0.5 and oracle.visible(o) in ("force", "both")
+
+
+def test_rival_is_the_oracle_over_what_was_reported(tmp_path):
+    """The truth over a report: where the judge named nothing, the gains over the nominal model
+    (the oracle's own, to the digit); where it reported the true model itself, none (both
+    measures 0: the records cannot tell a report from itself, a confusion); where it reported a
+    wrong offset, the true one is visible over it."""
+    dd = _write("test", 10, tmp_path)
+    truth = json.loads((dd / "truth.json").read_text())
+    o = oracle.measure(dd)
+    assert oracle.rival(dd, {"causes": [], "extended_model": None}) == o
+    same = oracle.rival(dd, {"extended_model": oracle.true_model_json(truth)})
+    for rec in ("fit", "val"):
+        assert same[rec]["force_gain"] == pytest.approx(0.0, abs=1e-12)
+        assert same[rec]["loop_gain"] == pytest.approx(0.0, abs=1e-12)
+    assert oracle.visible(same) == "neither"
+    wrong = oracle.true_model_json(truth)
+    wrong["plant"]["offset"] = -wrong["plant"]["offset"]
+    assert oracle.visible(oracle.rival(dd, {"extended_model": wrong})) != "neither"
+
+
+def _row(first: bool, found: bool, n: int = 1) -> dict:
+    return {"effects": [dict(first=first, found=found, moderate=True)] * n}
+
+
+@pytest.mark.parametrize("row, o_gain, rv_gain, expected", [
+    (_row(False, True), 0.9, 0.9, "found, not first"),
+    (_row(False, False), 0.01, 0.01, "invisible"),        # the exact effect below the bars over the nominal
+    (_row(False, False), 0.9, 0.02, "confusable"),        # ... above them, but not over what was reported
+    (_row(False, False), 0.9, 0.6, "resolvable"),         # ... and above them over the report too
+    (_row(False, False, 2), 0.9, 0.02, "confusable"),     # a pair: one found, the other not separable from it
+])
+def test_a_miss_is_classed_by_the_oracles_two_measures(row, o_gain, rv_gain, expected):
+    def rec(g):
+        return {r: dict(force_gain=g, loop_gain=g, used=100) for r in ("fit", "val")}
+    assert oracle.classify(row, rec(o_gain), rec(rv_gain)) == expected
+    assert oracle.classify(_row(False, False), rec(0.9), None) == "unmeasured"
