@@ -348,7 +348,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     if level is not None and "instead" in level:
         level = sliding_contradiction(level, model, kf, kv)
     if level is not None and "instead" in level and can_sim:
-        level = dwell_loop.static_contradiction(level, fit, validate, model, t_all, F_all, s_all)
+        level = dwell_loop.static_contradiction(level, fit, validate, model, t_all,
+                                                lambda m: excess(m, t_all, F_all, s_all))
     if level is not None:
         return dict(out, otherwise=level)
     if loop is None and can_sim:

@@ -250,7 +250,7 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
                 nominal=float(v0), extended=float(v1) if np.isfinite(v1) else float(v0), model=loop["model"])
 
 
-def static_contradiction(level: dict, fit_meas, val_meas, model, t, F, s) -> dict:
+def static_contradiction(level: dict, fit_meas, val_meas, model, t, excess) -> dict:
     """The break-away level verdict ``level`` (:func:`hunting.diagnose.causes.dwell.level_verdict`
     with its two readings, the dwell growth and the static level ``instead``) with the dwell
     reading's parameters fitted on the loop and the static level as its alternative (``also``)
@@ -267,8 +267,9 @@ def static_contradiction(level: dict, fit_meas, val_meas, model, t, F, s) -> dic
     cuts the static reading's position error by LOOP_GAIN on the fitting record and
     LOOP_VALIDATION_GAIN on the validation record (the bristles' and the unprompted growth's
     bars) and follows the validation record better than the nominal model. Its metric stays the
-    level verdict's: the break-away excess of every rest of both records (t, F, s: none of them
-    in the loop's fit), as :func:`hunting.diagnose.causes.dwell._loop_growth` has it.
+    level verdict's: the break-away excess of every rest of both records (``excess(model)``, (m,)
+    [N] for a model; none of those rests in the loop's fit), as
+    :func:`hunting.diagnose.causes.dwell._loop_growth` has it.
 
     reporting47 d0324: rests of 0.35-2.66 s, a 3.68 N growth complete in 0.094 s read as Fs 3.62 N
     higher; the true growth re-simulates the two records with 91 and 94 % less position error
@@ -277,7 +278,6 @@ def static_contradiction(level: dict, fit_meas, val_meas, model, t, F, s) -> dic
     reporting47 d0478's growth is named and the true static levels of reporting46 d0513 and d0556
     are kept."""
     from ..resimulate import position_rms_error
-    from .dwell import excess
     static = level["instead"]
     f_s, v_s = position_rms_error(fit_meas, static["model"]), position_rms_error(val_meas, static["model"])
     if not (np.isfinite(f_s) and np.isfinite(v_s) and f_s > 0):
@@ -296,7 +296,7 @@ def static_contradiction(level: dict, fit_meas, val_meas, model, t, F, s) -> dic
            f"follows both records better than with the static level raised: position RMS error -{gain_f:.0%} fitting, "
            f"-{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} needed)")
     named = {k: v for k, v in level.items() if k != "instead"}
-    e1 = excess(ext, t, F, s)
+    e1 = excess(ext)
     return dict(named, model=ext, parameters={"level": g.level, "gain": g.gain, "time": g.time},
                 sigma=sigma(ext, fit_meas, val_meas, model, times), fitted_on="loop",
                 evidence=f"{level['seen']}; but {why}: a growth from the break-away force Fs, its gain and time fitted there",
