@@ -103,20 +103,21 @@ def _gains(meas, nominal, base, model, window) -> dict:
 
 
 def _records(dd: Path):
+    """(records {"fit", "val"}, nominal model, true model, filter window [s]) of dataset ``dd``."""
     from hunting.diagnose import NominalModel, load
     from hunting.diagnose.parts import default_window
     truth = json.loads((dd / "truth.json").read_text())
     fit, val = load(dd / "fit.npz"), load(dd / "val.npz")
     nominal = NominalModel.from_json(dd / "model.json")
     true = NominalModel.from_dict(true_model_json(truth))
-    return truth, {"fit": fit, "val": val}, nominal, true, default_window(fit, val, nominal)
+    return {"fit": fit, "val": val}, nominal, true, default_window(fit, val, nominal)
 
 
 def measure(dd: Path) -> dict:
     """The oracle's gains for dataset directory ``dd`` (module docstring): per record ``fit`` and
     ``val``, the true model's force_gain and loop_gain over the nominal model (None where a
     measure cannot be formed), and the samples the force channel uses."""
-    _, recs, nominal, true, window = _records(dd)
+    recs, nominal, true, window = _records(dd)
     return {name: _gains(meas, nominal, nominal, true, window) for name, meas in recs.items()}
 
 
@@ -127,7 +128,7 @@ def rival(dd: Path, result: dict) -> dict:
     it needs over the nominal model, the data do not tell the reported explanation from the
     truth (the miss is a confusion the records cannot resolve, not a selection error)."""
     from hunting.diagnose import NominalModel
-    _, recs, nominal, true, window = _records(dd)
+    recs, nominal, true, window = _records(dd)
     ext = result.get("extended_model")
     base = NominalModel.from_dict(ext) if ext else nominal
     return {name: _gains(meas, nominal, base, true, window) for name, meas in recs.items()}

@@ -348,8 +348,9 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     if level is not None and "instead" in level:
         level = sliding_contradiction(level, model, kf, kv)
     if level is not None and "instead" in level and can_sim:
-        level = dwell_loop.static_contradiction(level, fit, validate, model, t_all,
-                                                lambda m: excess(m, t_all, F_all, s_all))
+        level = dwell_loop.static_contradiction(level, fit, validate, model, t_all)
+        if "instead" not in level:      # the loop's growth named: its break-away metric with the loop's values
+            level = _loop_metric(level, t_all, F_all, s_all)
     if level is not None:
         return dict(out, otherwise=level)
     if loop is None and can_sim:
@@ -422,13 +423,19 @@ def _loop_growth(level: dict, out: dict, record: dict, fit_meas, t_all, F_all, s
     f_res = position_rms_error(fit_meas, level["model"])
     if not (np.isfinite(f_loop) and (f_loop < f_res or not np.isfinite(f_res))):
         return level
-    e1 = excess(out["model"], t_all, F_all, s_all)
-    return dict(level, parameters=out["parameters"], sigma=out["sigma"], model=out["model"],
-                evidence=(f"{level['evidence']}; its gain and time fitted on the fitting record's re-simulated loop, "
-                          f"which follows that record better than the rests' fit (position RMS error {f_loop:.3g} "
-                          f"against {f_res:.3g} m)"),
-                metric=(f"break-away force RMS error [N], the {t_all.size} rests of both records (the growth fitted on "
-                        "the fitting record's loop)"),
+    return _loop_metric(dict(level, parameters=out["parameters"], sigma=out["sigma"], model=out["model"],
+                             evidence=(f"{level['evidence']}; its gain and time fitted on the fitting record's re-simulated "
+                                       f"loop, which follows that record better than the rests' fit (position RMS error "
+                                       f"{f_loop:.3g} against {f_res:.3g} m)")), t_all, F_all, s_all)
+
+
+def _loop_metric(level: dict, t_all, F_all, s_all) -> dict:
+    """A break-away level verdict whose growth (``level["model"]``) was fitted on the fitting
+    record's loop, with its metric the break-away excess of every rest of both records (t_all,
+    F_all, s_all (m,): none of them in the loop's fit)."""
+    e1 = excess(level["model"], t_all, F_all, s_all)
+    return dict(level, metric=(f"break-away force RMS error [N], the {t_all.size} rests of both records (the growth "
+                               "fitted on the fitting record's loop)"),
                 extended=float(np.sqrt(np.mean(e1 ** 2))))
 
 

@@ -250,7 +250,7 @@ def verdict(loop: dict, val_meas, model, p: float | None, prompt: str | None = N
                 nominal=float(v0), extended=float(v1) if np.isfinite(v1) else float(v0), model=loop["model"])
 
 
-def static_contradiction(level: dict, fit_meas, val_meas, model, t, excess) -> dict:
+def static_contradiction(level: dict, fit_meas, val_meas, model, t) -> dict:
     """The break-away level verdict ``level`` (:func:`hunting.diagnose.causes.dwell.level_verdict`
     with its two readings, the dwell growth and the static level ``instead``) with the dwell
     reading's parameters fitted on the loop and the static level as its alternative (``also``)
@@ -266,10 +266,9 @@ def static_contradiction(level: dict, fit_meas, val_meas, model, t, excess) -> d
     SHORT_STOP samples to twice the longest rest of both records, t (m,) [s]) and taken where it
     cuts the static reading's position error by LOOP_GAIN on the fitting record and
     LOOP_VALIDATION_GAIN on the validation record (the bristles' and the unprompted growth's
-    bars) and follows the validation record better than the nominal model. Its metric stays the
-    level verdict's: the break-away excess of every rest of both records (``excess(model)``, (m,)
-    [N] for a model; none of those rests in the loop's fit), as
-    :func:`hunting.diagnose.causes.dwell._loop_growth` has it.
+    bars) and follows the validation record better than the nominal model. Its metric, set by the
+    caller (:func:`hunting.diagnose.causes.dwell._loop_metric`), stays the level verdict's: the
+    break-away excess of every rest of both records, none of them in the loop's fit.
 
     reporting47 d0324: rests of 0.35-2.66 s, a 3.68 N growth complete in 0.094 s read as Fs 3.62 N
     higher; the true growth re-simulates the two records with 91 and 94 % less position error
@@ -296,11 +295,7 @@ def static_contradiction(level: dict, fit_meas, val_meas, model, t, excess) -> d
            f"follows both records better than with the static level raised: position RMS error -{gain_f:.0%} fitting, "
            f"-{gain_v:.0%} validation (at least {LOOP_GAIN:.0%} and {LOOP_VALIDATION_GAIN:.0%} needed)")
     named = {k: v for k, v in level.items() if k != "instead"}
-    e1 = excess(ext)
     return dict(named, model=ext, parameters={"level": g.level, "gain": g.gain, "time": g.time},
                 sigma=sigma(ext, fit_meas, val_meas, model, times), fitted_on="loop",
                 evidence=f"{level['seen']}; but {why}: a growth from the break-away force Fs, its gain and time fitted there",
-                metric=(f"break-away force RMS error [N], the {t.size} rests of both records (the growth fitted on the "
-                        "fitting record's loop)"),
-                extended=float(np.sqrt(np.mean(e1 ** 2))),
                 also=dict(static, evidence=f"{static['evidence']}; but {why}"))
