@@ -424,3 +424,19 @@ def test_levels_scaled_apart_count_as_an_asymmetry_with_a_coulomb_part_only():
     assert report.accept_names({"cause": "asymmetry", "accept": ["asymmetry"]}) == {"asymmetry"}
     assert report.accept_names({"cause": "offset", "accept": ["offset"]}) == {"offset"}
     assert report.accept_names({"cause": "level", "accept": ["level", "stribeck"]}) == {"level", "stribeck"}
+
+
+def test_bristles_state_their_stiffness_with_the_damping_the_loop_chose(tmp_path):
+    """reporting46 d0407 (development set since): LuGre bristles named presliding, sigma0 5 % low,
+    their damping ratio chosen on the loop with sigma0. Read at the chosen damping alone, its
+    uncertainty put the truth 2.6 of them off; the stiffness and damping's joint uncertainty
+    covers it within 2."""
+    generate.write("reporting46", tmp_path, indices=[407], progress=False)
+    dd = tmp_path / "d0407"
+    r = run.judge_hunting(dd)
+    named = {c["name"]: c for c in r["causes"]}
+    assert "presliding" in named, r["causes"]
+    c = named["presliding"]
+    truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]["sigma0"]
+    assert "zeta" in c["parameters"] and c["sigma"].get("sigma0")
+    assert abs(c["parameters"]["sigma0"] - truth) <= 2.0 * c["sigma"]["sigma0"], (c["parameters"], c["sigma"], truth)
