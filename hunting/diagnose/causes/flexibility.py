@@ -229,13 +229,13 @@ def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple
     a true 0.037, 9 of its standard uncertainties). The loop's ringing after each move fixes the
     damping: refined there, d0307 +22 % -> -6 %, d0377 -34 % -> -2 %, d0447 +24 % -> +7 %, d0559
     +146 % -> +40 %, d0577 -57 % -> +15 %. Returns (theta, hyper, sigma): sigma {load_mass,
-    damping} the larger of each value's within-record uncertainty on the loop
-    (:func:`~hunting.diagnose.loop_sigma.coefficient_sigma`, the other held) and its distance to
+    damping} the larger of each value's within-record uncertainty on the loop (the two together,
+    :func:`~hunting.diagnose.loop_sigma.coefficients_sigma`) and its distance to
     the force channel's value over sqrt(2) (two estimates of one value,
     :func:`~hunting.diagnose.loop_sigma.two_records`), and the stiffness's from the load mass's
     and the force channel's frequency uncertainty (``sigma``, the cause's, with ``frequency``)."""
     from ..loop_grid import grid_minimum
-    from ..loop_sigma import coefficient_sigma, two_records
+    from ..loop_sigma import coefficients_sigma, two_records
     from ..resimulate import position_rms_error
     m0, z0, f0 = float(theta[0]), float(hyper["damping"]), float(hyper["frequency"])
     top = 0.98 * model.mass
@@ -246,8 +246,9 @@ def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple
     lzs = np.linspace(-LOOP_SPAN[1], LOOP_SPAN[1], LOOP_GRID)
     _, lm, lz = grid_minimum(lambda a, b: position_rms_error(fit, at(a, b)), lms, lzs, LOOP_ROUNDS)
     m, z = min(m0 * 10.0 ** lm, top), z0 * 10.0 ** lz
-    s_lm = coefficient_sigma(fit, lambda x: at(x, lz), lm, LOOP_STEP)
-    s_lz = coefficient_sigma(fit, lambda x: at(lm, x), lz, LOOP_STEP)
+    # together: on the loop a heavier load and a more damped one trade (each read with the other
+    # held left that out)
+    s_lm, s_lz = coefficients_sigma(fit, lambda x: at(x[0], x[1]), np.array([lm, lz]), np.full(2, LOOP_STEP)) or (None, None)
     sig = {}
     for key, value, start, s in (("load_mass", m, m0, s_lm), ("damping", z, z0, s_lz)):
         # in decades of log10, then by the delta method in the value's units
