@@ -37,9 +37,10 @@ The rule (stated in every report, :data:`RULE`):
   (force-extended) model says the mass sticks: a chi-square test of the motion there against the
   sensor's quantization and noise (p < alpha), then a validation gain of at least ``min_gain`` in
   the re-simulated position error (controller known) or in the stick-segment displacement.
-  Where that test has nothing (no creep beyond the counts, or too few stick samples) and the
-  loop can be re-simulated, presliding's loop evidence judges bristles too stiff to creep at rest
-  by what they do where the loop turns and stops: fitted on the fitting record's re-simulated
+  Where that test has nothing (no creep beyond the counts, or too few stick samples), or the
+  stiffness fitted on the creep fails its validation gain, and the loop can be re-simulated,
+  presliding's loop evidence judges bristles too stiff to creep at rest (or whose creep alone
+  cannot fix the damping) by what they do where the loop turns and stops: fitted on the fitting record's re-simulated
   position, they must cut its position error by at least ``LOOP_GAIN`` and the validation
   record's by ``LOOP_VALIDATION_GAIN``
   (:func:`~hunting.diagnose.causes.presliding.loop_evidence`).
@@ -85,7 +86,7 @@ RULE = ("force channel: the best explanation (a set of at most {max_causes} caus
         "p < {alpha:g} and a validation gain of at least {min_gain:.0%} (saturation, whose evidence reads only the measured "
         "output, and quantization, whose evidence reads only the recorded signals, first: where one holds on the nominal "
         "model every other channel is judged on its extension, and where it fails there it is judged again last, on "
-        "theirs); presliding, where no creep shows at rest, also "
+        "theirs); presliding, where no creep shows at rest or the creep's fit fails its validation gain, also "
         "when LuGre bristles fitted on the fitting record's re-simulated loop cut that record's position error by at least "
         "{loop_gain:.0%} and the validation record's by {loop_val_gain:.0%}; where too few samples slide for the force balance, the one-parameter force-channel cause "
         "that fitted on the fitting record's loop cuts its position error most, when it cuts both records' by at least "
@@ -725,7 +726,12 @@ def _stick_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim):
         metric = "stick-segment displacement RMS [m], validation"
     gain = relative_fall(before, after)
     if gain < min_gain:
-        return reject(gain, _gain_words(before, after, min_gain, metric))
+        why = _gain_words(before, after, min_gain, metric)
+        if can_sim:
+            # the creep's fit (at the damping ratio ZETA, which creep cannot fix) fails out of
+            # sample: the loop evidence judges the bristles as where no creep shows
+            return _loop_channel(mod, fit, val, model, can_sim, (chi2, p), why)
+        return reject(gain, why)
     hyper = {}
     if can_sim and hasattr(mod, "refine_stiffness"):
         theta, hyper, after, ext = _refined_stiffness(mod, fit, val, model, theta, hyper, after, ext,
