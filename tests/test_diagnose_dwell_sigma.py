@@ -64,3 +64,24 @@ def test_a_time_the_rests_cannot_see_leaves_the_gain_its_own_uncertainty():
     sd = dwell._joint_sigma(t, gain=1.0, tau=0.01, ss=0.01, level=False)
     assert sd[1] is None                        # the time: its column of the Jacobian is zero
     assert np.isclose(sd[0], np.sqrt(0.01 / (t.size - 1) / t.size))
+
+
+def test_the_joint_uncertainty_is_the_least_squares_covariance_of_a_finite_difference_jacobian():
+    """An independent Jacobian: central differences of the growth in level, gain and time, and the
+    textbook covariance (J^T J)^-1 ss / (m - p); with and without the level."""
+    t = np.geomspace(0.04, 0.5, 9)
+    th = np.array([0.2, 1.3, 0.12])            # level [N], gain [N], time [s]
+    ss = 0.02
+
+    def growth(p):
+        return p[0] + p[1] * (1 - np.exp(-t / p[2]))
+    for level in (True, False):
+        keep = [0, 1, 2] if level else [1, 2]
+        J = np.empty((t.size, len(keep)))
+        for j, k in enumerate(keep):
+            h = np.zeros(3)
+            h[k] = 1e-6 * abs(th[k])
+            J[:, j] = (growth(th + h) - growth(th - h)) / (2 * h[k])
+        expected = np.sqrt(np.diag(np.linalg.inv(J.T @ J)) * ss / (t.size - len(keep)))
+        got = dwell._joint_sigma(t, gain=th[1], tau=th[2], ss=ss, level=level)
+        assert np.allclose(got, expected, rtol=1e-5), (got, expected)

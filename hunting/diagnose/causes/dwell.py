@@ -672,9 +672,9 @@ def _joint_sigma(t, gain: float, tau: float, ss: float, level: bool) -> list:
     The time is fitted too, and the gain trades off against it, and a level against both, over
     rests that do not span the growth: the gain's uncertainty read at the fitted time alone left
     that out (blind development sets reporting46-49: of the 8 growths fitted on the rests with a
-    level, 5 lay more than 2 of those uncertainties from the true gain, 3 with these)."""
+    level off zero, 5 lay more than 2 of those uncertainties from the true gain, 3 with these)."""
     x = np.exp(-t / tau)
-    J = np.column_stack(([np.ones_like(t)] if level else []) + [1 - x, gain * t / tau ** 2 * x])
+    J = np.column_stack(([np.ones_like(t)] if level else []) + [1 - x, -gain * t / tau ** 2 * x])
     norm = np.linalg.norm(J, axis=0)
     ok = norm > 1e-12 * max(float(norm.max()), 1e-300)
     sd = np.full(J.shape[1], np.nan)

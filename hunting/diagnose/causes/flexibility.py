@@ -248,7 +248,8 @@ def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple
     m, z = min(m0 * 10.0 ** lm, top), z0 * 10.0 ** lz
     # together: on the loop a heavier load and a more damped one trade (each read with the other
     # held left that out)
-    s_lm, s_lz = coefficients_sigma(fit, lambda x: at(x[0], x[1]), np.array([lm, lz]), np.full(2, LOOP_STEP)) or (None, None)
+    s_lm, s_lz = (coefficients_sigma(fit, lambda x: at(x[0], x[1]), np.array([lm, lz]), np.full(2, LOOP_STEP))
+                  or (None, None))
     sig = {}
     for key, value, start, s in (("load_mass", m, m0, s_lm), ("damping", z, z0, s_lz)):
         # in decades of log10, then by the delta method in the value's units

@@ -35,7 +35,7 @@ fitting record's loop (:func:`refine_stiffness`)."""
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..loop_sigma import coefficient_sigma, coefficients_sigma, two_records
+from ..loop_sigma import coefficients_sigma, two_records
 from ..stats import relative_fall
 from ._words import _q, cut_words, pct_against
 
@@ -372,13 +372,12 @@ def log_sigma0_sigma(fit, val, model, theta, segs, segs_val, hyper: dict | None 
     hyper = hyper or {}
     lg = -float(np.log10(theta[0]))
     residual = None if segs is None else (lambda q_sim: creep_residual(q_sim, fit.q, segs))
-    if "zeta" in hyper:
-        sd = coefficients_sigma(fit, lambda x: extend(model, np.array([10.0 ** -x[0]]), dict(hyper, zeta=10.0 ** x[1])),
-                                np.array([lg, np.log10(hyper["zeta"])]), np.full(2, SIGMA_DECADES), residual=residual)
-        sig = None if sd is None else sd[0]
-    else:
-        sig = coefficient_sigma(fit, lambda x: extend(model, np.array([10.0 ** -x]), hyper), lg, SIGMA_DECADES,
-                                residual=residual)
+    x = np.array([lg] + ([np.log10(hyper["zeta"])] if "zeta" in hyper else []))
+
+    def model_at(v):
+        return extend(model, np.array([10.0 ** -v[0]]), dict(hyper, zeta=10.0 ** v[1]) if v.size > 1 else hyper)
+    sd = coefficients_sigma(fit, model_at, x, np.full(x.size, SIGMA_DECADES), residual=residual)
+    sig = None if sd is None else sd[0]
     if sig is None:
         return None
     if segs is None:
