@@ -34,7 +34,8 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     and testable on the validation record are searched on alternate blocks of the validation
     record (:func:`~hunting.diagnose.parts.interleaved`) and judged on the others, on top of the
     model the channel extended (reporting10 d0313 and d0327: a Coulomb level 8 % and 2 % low, the
-    fitting record sliding one way, where a level is an offset, left untested). Their rows in
+    fitting record sliding one way, where a level is an offset, left untested), and so is a cause
+    of their family that ``NESTS`` one of them when the blocks choose it. Their rows in
     ``untested`` are replaced by what that search says. fc is returned unchanged when there are
     none or the parts are not :func:`~hunting.diagnose.parts.informative`."""
     ext = fc["model"]
@@ -67,7 +68,13 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
                                        alpha_reference, inner)
     from .force import compatible
     chosen = {c.name: c for c in judged["causes"]}
-    held = [n for n in cross if n in chosen]
+    # a mate that generalises a cross cause (its NESTS) contains the part the fitting record cannot
+    # show, so that record's own test of it judged an extrapolation: the blocks, which show all of
+    # it, decide it like a cross cause (reporting51 d0331: a Stribeck dip on a one-way fitting
+    # record, fitted there at 1.88 N RMS on the validation data against the nominal 0.95, chosen on
+    # the blocks in place of the level it nests)
+    nesting = [n for n in mates if n in chosen and set(getattr(CAUSES[n], "NESTS", ())) & set(cross)]
+    held = [n for n in cross if n in chosen] + nesting
     # a cross cause kept in place of a found one it excludes would be refitted on top of it
     # (level_asymmetry, untestable on a one-way fitting record, over an offset found there); one
     # that generalises it (its NESTS) and that the blocks chose in its place replaces it, judged
@@ -95,14 +102,15 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     kept = {c.name for c in fc2["causes"]}
     joint = None
     if replacing:
-        joint = _joint_values(found, [n for n in cross if n in kept or n in replacing], parts, model, rule)
+        joint = _joint_values(found, [n for n in list(cross) + nesting if n in kept or n in replacing], parts, model,
+                              rule)
         if joint is None:      # reported in place of its special case or not at all
             clash.update({n: nested[n] for n in replacing})
         else:
             fc2 = dict(fc2, causes=list(fc2["causes"]) + [chosen[n] for n in replacing])
             kept |= set(replacing)
     if joint is None and kept:
-        joint = _joint_values(found, [n for n in cross if n in kept], parts, model, rule)
+        joint = _joint_values(found, [n for n in list(cross) + nesting if n in kept], parts, model, rule)
     fc2["rejected"] = [r for r in judged["rejected"] if r["name"] in cross and r["name"] not in kept] + [
         r for r in fc2["rejected"] if r["name"] in cross]
     fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "
@@ -116,7 +124,8 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
                                if r["name"] in cross else r for r in fc2["rejected"]]
     inner = [u for u in inner if u["name"] in cross]
     untested[:] = [u for u in untested if u["name"] not in cross] + inner
-    said = ", ".join(cross)
+    said = ", ".join(list(cross) + [f"{n} (for the {', '.join(c for c in CAUSES[n].NESTS if c in cross)} it nests)"
+                                     for n in nesting])
     notes.append(VALIDATION_ONLY_NOTE.format(names=said, reasons="; ".join(f"{n}: {r}" for n, r in cross.items()),
                                              val=validate.name))
     rejected = [dict(r, reason=f"{r['reason']} (fitted on alternate blocks of {validate.name}, judged on the others)")
@@ -137,7 +146,9 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
         r_val_ext = fc["r_val_ext"] - force_change(fc2["causes"], kv, ext)
     finite = r_val_ext[np.isfinite(r_val_ext)]
     extended = float(np.sqrt(np.mean(finite ** 2))) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
-    return dict(fc, causes=causes, rejected=_partly_rows(fc["rejected"], rejected, partly, kept),
+    # a nesting mate's row from the fitting record stays, with what the blocks said of it
+    twice = dict(partly, **{n: "" for n in nesting})
+    return dict(fc, causes=causes, rejected=_partly_rows(fc["rejected"], rejected, twice, kept),
                 model=model_out, alternatives=[a for a in list(fc["alternatives"]) + list(fc2["alternatives"])
                                                if a.get("replaces") not in {c.name for c in shadows}],
                 explanations=list(fc["explanations"]) + list(fc2["explanations"]), r_val_ext=r_val_ext,
