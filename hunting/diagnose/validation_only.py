@@ -147,8 +147,8 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     finite = r_val_ext[np.isfinite(r_val_ext)]
     extended = float(np.sqrt(np.mean(finite ** 2))) if fc2["causes"] and fc["extended"] is not None else fc["extended"]
     # a nesting mate's row from the fitting record stays, with what the blocks said of it
-    twice = dict(partly, **{n: "" for n in nesting})
-    return dict(fc, causes=causes, rejected=_partly_rows(fc["rejected"], rejected, twice, kept),
+    one_row = dict(partly, **{n: "" for n in nesting})
+    return dict(fc, causes=causes, rejected=_partly_rows(fc["rejected"], rejected, one_row, kept),
                 model=model_out, alternatives=[a for a in list(fc["alternatives"]) + list(fc2["alternatives"])
                                                if a.get("replaces") not in {c.name for c in shadows}],
                 explanations=list(fc["explanations"]) + list(fc2["explanations"]), r_val_ext=r_val_ext,
