@@ -103,9 +103,9 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
     nothing re-simulates). ``rest_times`` (m,) [s]: the record's rests, which span the time grid;
     ``start``: (gain [N], time [s]) tried beside the grid (the break-away readings' fit);
     ``floor`` [m]: where the grid's best error is not below it, the grid's best is returned (no
-    Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone (no fine line in the gain); ``sliding``: the growth's
-    form (:class:`~hunting.diagnose.model.Dwell`; None: the model's own, Kato's where it has
-    none)."""
+    fine line, no Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone (no fine line in
+    the gain); ``sliding``: the growth's form (:class:`~hunting.diagnose.model.Dwell`; None: the
+    model's own, Kato's where it has none)."""
     from scipy.optimize import minimize
 
     from ..resimulate import position_rms_error
