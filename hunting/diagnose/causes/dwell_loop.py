@@ -11,8 +11,8 @@ differently. So wherever the growth test's p is below :data:`GATE` (the rests su
 and the loop can be re-simulated, the growth is fitted on the fitting record's re-simulated
 position (:func:`fit`: the break-away force after a rest t is the model's + gain (1 - exp(-t /
 time)), its level held at the model's; whole-record RMS error, a geometric grid and then
-a fine line in the gain at the grid's best time, then Nelder-Mead on log gain and log time, at most GAINS x
-TIMES + LINE + EVALS re-simulations).
+then Nelder-Mead on log gain and log time, at most GAINS x TIMES + EVALS re-simulations; unprompted,
+below, a fine line in the gain at the grid's best time before it, LINE more).
 
 - The parameters: of the break-away reading's fit and the loop's, the one that re-simulates the
   fitting record better, the loop's only where it beats the nominal model there (:func:`refine`).
@@ -103,8 +103,8 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
     nothing re-simulates). ``rest_times`` (m,) [s]: the record's rests, which span the time grid;
     ``start``: (gain [N], time [s]) tried beside the grid (the break-away readings' fit);
     ``floor`` [m]: where the grid's best error is not below it, the grid's best is returned (no
-    fine line, no Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone (no fine line in
-    the gain); ``sliding``: the growth's form (:class:`~hunting.diagnose.model.Dwell`; None: the
+    fine line, no Nelder-Mead; with a floor, the grid's best is first moved along a fine line in
+    the gain); ``grid`` False: Nelder-Mead from ``start`` alone; ``sliding``: the growth's form (:class:`~hunting.diagnose.model.Dwell`; None: the
     model's own, Kato's where it has none)."""
     from scipy.optimize import minimize
 
@@ -129,13 +129,15 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
         return model, np.inf
     x0 = min(points, key=cost)
     if np.isfinite(cost(x0)) and (floor is None or cost(x0) < floor):
-        if grid:
-            # the loop's error falls into a valley in the gain far narrower than the grid's step
-            # (a contact that breaks away a little later slips and rests differently), and
-            # Nelder-Mead from the grid's point stops on its slope: the gain on a fine line at
-            # that point's time first (reporting51 d0422, a 0.89 N growth over 0.47 s: from the
-            # grid 0.53 N at 0.22 s, 45 % of the error cut; the best gain at that time, 0.75 N,
-            # cuts 76 %)
+        if grid and floor is not None:
+            # unprompted, from the grid alone: the loop's error falls into a valley in the gain
+            # far narrower than the grid's step (a contact that breaks away a little later slips
+            # and rests differently), and Nelder-Mead from the grid's point stops on its slope:
+            # the gain on a fine line at that point's time first (reporting51 d0422, a 0.89 N
+            # growth over 0.47 s: from the grid 0.53 N at 0.22 s, 45 % of the error cut; the best
+            # gain at that time, 0.75 N, cuts 76 %). Where the readings' fit is a start it lies
+            # in the valley already, and the line moved the fit off the truth (reporting15 d0394's
+            # gain 8 % off, within 5 % without; reporting21 d0380's time 19 % off)
             x0 = min([x0] + [(x0[0] + d, x0[1]) for d in np.log(np.geomspace(*LINE_RANGE, LINE))], key=cost)
         # from a start alone, a simplex of fixed steps in log gain and log time (scipy's default,
         # 5 % of |x0|, is tiny near log 1 = 0: a refit from the other record's values hardly moved)
