@@ -61,7 +61,7 @@ def _compile_kernels(tmp_path, *kinds):
     """Compile kernels ``kinds`` into the test's fresh numba cache with the helper's program."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
     proc = subprocess.Popen([sys.executable, "-m", "hunting.integrate.compile_kernels", *kinds], env=env,
-                            stdin=subprocess.PIPE)                  # its stdin open: it compiles them all
+                            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL)   # stdin open: it compiles them all
     try:
         assert proc.wait(timeout=600) == 0
     finally:
@@ -178,8 +178,10 @@ def test_a_stopped_helper_finishes_its_kernel_and_starts_no_other(tmp_path):
     kill between numba's index and data writes could leave an entry naming another file)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
     proc = subprocess.Popen([sys.executable, "-m", "hunting.integrate.compile_kernels", "lean", "full"], env=env,
-                            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    time.sleep(4.0)                                  # imports done, the lean kernel compiling
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # stopped once the lean kernel is begun (a fixed wait let a fast machine finish it and begin
+    # the full one first)
+    assert proc.stdout.readline().strip() == "compiling lean"
     proc.stdin.close()
     assert proc.wait(timeout=300) == 0, proc.stderr.read()
     names = " ".join(os.listdir(tmp_path / "numba")) if (tmp_path / "numba").exists() else ""

@@ -3,7 +3,8 @@ hunting.integrate.compile_kernels KIND ...`` compiles each integration kernel na
 :data:`hunting.integrate._kernel.KINDS`), in order, into numba's disk cache, as a command
 would (:func:`hunting.integrate._kernel.compiled`, under the kernels' cache lock). When its
 standard input closes (the command that started it has ended or stopped it) it finishes the
-kernel it is compiling and ends: numba writes a kernel's index entry before its data file, so a
+kernel it is compiling and ends (it prints "compiling KIND" to its standard output as it begins
+each one): numba writes a kernel's index entry before its data file, so a
 helper killed in between could leave an entry naming another kernel's file."""
 from __future__ import annotations
 
@@ -39,6 +40,7 @@ def main(argv: list[str]) -> int:
             # a pause with the lock free: a command waiting to load the kernel just compiled
             # (it polls every POLL) takes the lock before this compiles the next one
             time.sleep(3 * POLL)
+        print(f"compiling {kind}", flush=True)     # progress: the caller may read which kernel is begun
         K.compiled(kind)
     return 0
 
