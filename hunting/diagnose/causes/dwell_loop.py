@@ -11,7 +11,7 @@ differently. So wherever the growth test's p is below :data:`GATE` (the rests su
 and the loop can be re-simulated, the growth is fitted on the fitting record's re-simulated
 position (:func:`fit`: the break-away force after a rest t is the model's + gain (1 - exp(-t /
 time)), its level held at the model's; whole-record RMS error, a geometric grid and then
-then Nelder-Mead on log gain and log time, at most GAINS x TIMES + EVALS re-simulations; unprompted,
+Nelder-Mead on log gain and log time, at most GAINS x TIMES + EVALS re-simulations; unprompted,
 below, a fine line in the gain at the grid's best time before it, LINE more).
 
 - The parameters: of the break-away reading's fit and the loop's, the one that re-simulates the
@@ -97,15 +97,16 @@ def form_words(dwell) -> str:
 
 
 def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None = None,
-        grid: bool = True, sliding: bool | None = None) -> tuple[object, float]:
+        grid: bool = True, sliding: bool | None = None, line: bool = False) -> tuple[object, float]:
     """(model, error): ``model`` with the dwell growth (gain [N], time [s]; level the model's)
     that minimizes the re-simulated position RMS error [m] on ``meas``, and that error (inf where
     nothing re-simulates). ``rest_times`` (m,) [s]: the record's rests, which span the time grid;
     ``start``: (gain [N], time [s]) tried beside the grid (the break-away readings' fit);
     ``floor`` [m]: where the grid's best error is not below it, the grid's best is returned (no
-    fine line, no Nelder-Mead; with a floor, the grid's best is first moved along a fine line in
-    the gain); ``grid`` False: Nelder-Mead from ``start`` alone; ``sliding``: the growth's form (:class:`~hunting.diagnose.model.Dwell`; None: the
-    model's own, Kato's where it has none)."""
+    Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone; ``sliding``: the growth's form
+    (:class:`~hunting.diagnose.model.Dwell`; None: the model's own, Kato's where it has none);
+    ``line``: the grid's best point moved along a fine line in the gain (LINE points over
+    LINE_RANGE times its gain, at its time) before Nelder-Mead."""
     from scipy.optimize import minimize
 
     from ..resimulate import position_rms_error
@@ -129,7 +130,7 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
         return model, np.inf
     x0 = min(points, key=cost)
     if np.isfinite(cost(x0)) and (floor is None or cost(x0) < floor):
-        if grid and floor is not None:
+        if line:
             # unprompted, from the grid alone: the loop's error falls into a valley in the gain
             # far narrower than the grid's step (a contact that breaks away a little later slips
             # and rests differently), and Nelder-Mead from the grid's point stops on its slope:
@@ -205,7 +206,7 @@ def unprompted(fit_meas, val_meas, model, rest_times, prompt: str) -> dict:
     from ..resimulate import position_rms_error
     f0 = position_rms_error(fit_meas, model)
     floor = f0 * (1.0 - SCREEN * LOOP_GAIN) if np.isfinite(f0) else None
-    ext, f1 = fit(fit_meas, model, rest_times, floor=floor)
+    ext, f1 = fit(fit_meas, model, rest_times, floor=floor, line=True)
     out = verdict(dict(model=ext, fit=(f0, f1), reading=None), val_meas, model, None, prompt,
                   fit_meas=fit_meas, rest_times=rest_times)
     # a break-away level the rests do not show growing is also the static level's error: where the
