@@ -68,7 +68,9 @@ def test_a_time_the_rests_cannot_see_leaves_the_gain_its_own_uncertainty():
 
 def test_the_joint_uncertainty_is_the_least_squares_covariance_of_a_finite_difference_jacobian():
     """An independent Jacobian: central differences of the growth in level, gain and time, and the
-    textbook covariance (J^T J)^-1 ss / (m - p); with and without the level."""
+    textbook covariance (J^T J)^-1 ss / (m - p); with and without the level. It checks each
+    column's scale and the covariance's form; the standard uncertainties (the diagonal) do not
+    depend on a column's sign, so the time column's sign is not observable here."""
     t = np.geomspace(0.04, 0.5, 9)
     th = np.array([0.2, 1.3, 0.12])            # level [N], gain [N], time [s]
     ss = 0.02

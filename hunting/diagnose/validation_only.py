@@ -75,6 +75,7 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     # the blocks in place of the level it nests)
     nesting = [n for n in mates if n in chosen and set(getattr(CAUSES[n], "NESTS", ())) & set(cross)]
     held = [n for n in cross if n in chosen] + nesting
+    searched = list(cross) + nesting         # the causes this search may report
     # a cross cause kept in place of a found one it excludes would be refitted on top of it
     # (level_asymmetry, untestable on a one-way fitting record, over an offset found there); one
     # that generalises it (its NESTS) and that the blocks chose in its place replaces it, judged
@@ -102,15 +103,14 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     kept = {c.name for c in fc2["causes"]}
     joint = None
     if replacing:
-        joint = _joint_values(found, [n for n in list(cross) + nesting if n in kept or n in replacing], parts, model,
-                              rule)
+        joint = _joint_values(found, [n for n in searched if n in kept or n in replacing], parts, model, rule)
         if joint is None:      # reported in place of its special case or not at all
             clash.update({n: nested[n] for n in replacing})
         else:
             fc2 = dict(fc2, causes=list(fc2["causes"]) + [chosen[n] for n in replacing])
             kept |= set(replacing)
     if joint is None and kept:
-        joint = _joint_values(found, [n for n in list(cross) + nesting if n in kept], parts, model, rule)
+        joint = _joint_values(found, [n for n in searched if n in kept], parts, model, rule)
     fc2["rejected"] = [r for r in judged["rejected"] if r["name"] in cross and r["name"] not in kept] + [
         r for r in fc2["rejected"] if r["name"] in cross]
     fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "
