@@ -192,7 +192,7 @@ def unseen(kf, kv, model) -> str | None:
         return None
     return (f"a resonance the fitting record's motion does not excite: at {h['frequency']:.3g} Hz (damping "
             f"{h['damping']:.2g}) it explains {s_v:.0%} of the validation record's force residual and "
-            f"{max(s_f, 0.0):.0%} of the fitting record's")
+            f"{s_f:.0%} of the fitting record's")
 
 
 def seen(hyper, kf, model) -> str | None:
