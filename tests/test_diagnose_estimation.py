@@ -877,8 +877,12 @@ def test_dwell_whose_break_away_readings_show_nothing_is_named_on_the_loop_unpro
     validation record's break-aways are read on force ramps of 20-29 N, and the growth test on
     the 11 rests gives p = 0.39, above the loop's gate: nothing was named. The growth fitted on the
     fitting record's loop anyway cuts both records' position errors by more than LOOP_GAIN: named
-    on that evidence, its gain within 10 % and covered by two stated uncertainties; the time,
-    which every rest outlasts, states none."""
+    on that evidence, its gain within 10 % and covered by two stated uncertainties. With the fine
+    gain line at every time of the grid (the fortieth session) the fit reaches the valley at the
+    growth's own time (0.094 s, 11 % short, 95 and 91 % of the two records' errors cut): the
+    time states an uncertainty that covers the truth too. Before, from the grid's best time, the
+    fit ended at 9 ms, which every rest outlasts (no uncertainty; gain 4.8 % low, 75 % cut on the
+    validation record)."""
     from hunting.diagnose.causes.presliding import LOOP_GAIN
     fit, val, model, truth = _dataset("reporting28", 366)
     d = diagnose(fit, model, val, causes=["dwell"], behaviour=False)
@@ -888,7 +892,8 @@ def test_dwell_whose_break_away_readings_show_nothing_is_named_on_the_loop_unpro
     assert 1 - c.gain["extended"] / c.gain["nominal"] >= LOOP_GAIN
     assert c.parameters["gain"] == pytest.approx(true["gain"], rel=0.1)
     assert abs(c.parameters["gain"] - true["gain"]) <= 2 * c.sigma["gain"]
-    assert c.sigma["time"] is None
+    assert c.parameters["time"] == pytest.approx(true["time"], rel=0.2)
+    assert abs(c.parameters["time"] - true["time"]) <= 2 * c.sigma["time"]
 
 
 def test_no_unprompted_dwell_beside_a_static_level_the_force_channel_moved():
