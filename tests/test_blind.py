@@ -487,6 +487,24 @@ def test_a_dwell_growth_whose_gain_valley_the_loop_grid_steps_over_is_found_on_a
     assert r["causes"][0]["parameters"]["gain"] == pytest.approx(truth["gain"], rel=0.3)
 
 
+def test_a_stribeck_dip_too_small_on_the_sliding_samples_is_named_from_the_loop_where_nothing_else_is(tmp_path):
+    """reporting48 d0429 (development set since): a Stribeck dip (Fs 17.3 N over the nominal
+    Coulomb 13.3 N at 3 mm/s, no dip in the nominal model) on a one-way fitting record. The force
+    channel's Stribeck fit is significant and validated, but changes the friction force on the
+    sliding samples by 0.017 N RMS, below the relevance floor (0.04 N): nothing was named. At its
+    fitted values the re-simulated loop follows both records far better (the exact change: 100 %
+    of both position errors), so it is named, its levels within 1 %."""
+    generate.write("reporting48", tmp_path, indices=[429], progress=False)
+    dd = tmp_path / "d0429"
+    r = run.judge_hunting(dd)
+    assert [c["name"] for c in r["causes"]] == ["stribeck"], (r["causes"], r["rejected"])
+    truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
+    got = r["causes"][0]["parameters"]
+    assert got["Fc"] == pytest.approx(truth["Fc"], rel=0.01)
+    assert got["Fs"] == pytest.approx(truth["Fs"], rel=0.01)
+    assert not any(row["name"] == "stribeck" for row in r["rejected"]), r["rejected"]
+
+
 def test_a_dwell_growth_in_a_valley_away_from_the_loop_grids_best_time_is_found_on_a_line_there(tmp_path):
     """reporting53 d0422 (development set since): a 1.31 N dwell growth over 31 ms. The loop's
     error has two valleys along the gain: at the grid's best time, 0.41 s, the fine line reached

@@ -586,8 +586,7 @@ def select(lib: Library, max_causes: int, alpha: float, min_gain: float, alpha_r
                                  p_value=tests[worst]["p_value"], validation_gain=tests[worst]["gain"],
                                  reason=_why(tests[worst], alpha, min_gain, alpha_reference),
                                  reference_only=reference_only(tests[worst], alpha, min_gain, alpha_reference),
-                                 **_significance_only_row(lib, current, worst, tests[worst], alpha, min_gain,
-                                                          alpha_reference)))
+                                 **_loop_row(lib, current, worst, tests[worst], alpha, min_gain, alpha_reference)))
             dropped.add(worst)
             current = _physical_subset(lib, fits, tuple(n for n in current.names if n != worst), rejected)
             current = _next_untried(ranking, dropped, current)
@@ -676,6 +675,17 @@ def reference_only(t: dict, alpha: float, min_gain: float, alpha_reference: floa
         {k: v for k, v in t.items() if k not in along}, alpha, min_gain, alpha_reference)
 
 
+def small_only(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:
+    """Whether a member's tests (:func:`_tests`) fail the rule only by the size of its force
+    change (the relevance floor, :func:`relevance_floor`, or the precision floor): significant out
+    of sample and along the reference trajectory, with its validation gain, but changing the
+    friction force on the sliding samples too little to be named from them. Where no channel
+    names anything the loop still judges it at its fitted coefficients
+    (:func:`hunting.diagnose.select._small_on_loop`)."""
+    return _fails(t, alpha, min_gain, alpha_reference) and not _fails(
+        dict(t, change=np.inf, floor=-np.inf), alpha, min_gain, alpha_reference)
+
+
 def significance_only(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:
     """Whether a member's tests (:func:`_tests`) fail the rule only in the out-of-sample
     significance (p_value >= alpha; its validation gain and every other test pass): the loop can
@@ -683,16 +693,18 @@ def significance_only(t: dict, alpha: float, min_gain: float, alpha_reference: f
     return t["p_value"] >= alpha and not _fails(dict(t, p_value=0.0), alpha, min_gain, alpha_reference)
 
 
-def _significance_only_row(lib, current, name: str, t: dict, alpha: float, min_gain: float,
-                           alpha_reference: float) -> dict:
-    """The fields a rejected row gets when its member failed only the significance test
-    (:func:`significance_only`): ``significance_only`` and the member's fitted ``theta`` and
-    ``hyper`` in ``current``; empty otherwise."""
-    if not significance_only(t, alpha, min_gain, alpha_reference):
+def _loop_row(lib, current, name: str, t: dict, alpha: float, min_gain: float, alpha_reference: float) -> dict:
+    """The fields a rejected row gets when the loop may still judge its member at its fitted
+    coefficients: ``significance_only`` (:func:`significance_only`) or ``small_only``
+    (:func:`small_only`) True, and the member's fitted ``theta`` and ``hyper`` in ``current``;
+    empty otherwise."""
+    flags = {k: True for k, test in (("significance_only", significance_only), ("small_only", small_only))
+             if test(t, alpha, min_gain, alpha_reference)}
+    if not flags:
         return {}
     for nm, v, theta in lib._members(current):
         if nm == name:
-            return dict(significance_only=True, theta=np.array(theta, dtype=float), hyper=dict(v.hyper))
+            return dict(flags, theta=np.array(theta, dtype=float), hyper=dict(v.hyper))
     return {}
 
 
