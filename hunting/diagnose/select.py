@@ -244,6 +244,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
         fc = _loop_admission(fc, fit, validate)
         fc = _loop_confirmation(fc, fit, validate)
         fc = _loop_refined(fc, fit, validate, kf)
+    # the fitted coefficients of the causes rejected only for their small force change, which the
+    # loop judges where no channel names anything (:func:`_small_on_loop`); rows leave without them
+    small_fits = {r["name"]: dict(theta=r["theta"], hyper=r["hyper"]) for r in fc["rejected"]
+                  if r.get("small_only") and "theta" in r}
+    fc = dict(fc, rejected=[{k: v for k, v in r.items() if k not in ("theta", "hyper")} for r in fc["rejected"]])
     ext = fc["model"]
     result, rejected = result + list(fc["causes"]), rejected + list(fc["rejected"])
     for name in stick_names:
@@ -293,15 +298,16 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
                 untested.append(dict(name=name, reason=row["reason"]))
             else:
                 rejected.append(row)
-    if not result and can_sim and blocks is None:
-        judged = _small_on_loop([r for r in rejected if r.get("small_only") and "theta" in r], rejected, ext, fit,
-                                validate)
+    if small_fits and not result and can_sim and blocks is None:
+        rejected = [dict(r, **small_fits[r["name"]]) if r.get("small_only") and r["name"] in small_fits else r
+                    for r in rejected]
+        judged = _small_on_loop([r for r in rejected if "theta" in r], rejected, ext, fit, validate)
         if judged is not None:
             rejected, cause, loop_ext = judged
             if cause is not None:
                 result, ext = [cause], loop_ext
                 fc["alternatives"] = [a for a in fc["alternatives"] if a.get("name") != cause.name]
-    rejected = [{k: v for k, v in r.items() if k not in ("theta", "hyper")} for r in rejected]
+        rejected = [{k: v for k, v in r.items() if k not in ("theta", "hyper")} for r in rejected]
     # one ranking over the channels: the relative worsening of each cause's own validation metric
     # without it
     result.sort(key=lambda c: -c.score)
