@@ -176,7 +176,7 @@ def unseen(kf, kv, model) -> str | None:
     1.2 and is not at 3), or its motion does not excite one the validation record's does: the
     validation record's best candidate explains VALIDATION_SHARE of its force residual and the
     same resonance less than 1/SHARE_FACTOR of that share of the fitting record's (reporting53
-    d0433, 7.7 Hz: 92 and 0 %; d0503, 25.6 Hz: 80 and 1 %; both bands 50 Hz or more)."""
+    d0433, 7.7 Hz: 92 and 0 %; d0503, 25.6 Hz: 79 and 1 %; both bands 50 Hz or more)."""
     hf, hv = band(kf)[1], band(kv)[1]
     if hv > UNSEEN_FACTOR * hf:
         return (f"a resonance above {hf:.3g} Hz (the fitting record's acceleration is the position sensor's noise "
