@@ -714,7 +714,19 @@ def test_seen_rejects_a_resonance_the_fitting_record_shows_in_its_band():
     kf = kinematics(fit, model.cm, resolution=model.resolution)
     true = truth["effects"][0]["params"]
     hyper = {"frequency": true["frequency"], "damping": true["damping"]}
-    assert flexibility.residual_share(kf, model, hyper) > 0.9
+    share = flexibility.residual_share(kf, model, hyper)
+    assert share > 0.9
+    # the same share from an independent least-squares fit of the residual about its mean on the
+    # regressor (a load mass alone, no constant)
+    from hunting.diagnose.kinematics import residual
+    from hunting.diagnose.model import highpass_response
+    r = residual(kf, model)
+    m = kf.moving & np.isfinite(r)
+    y = r[m] - r[m].mean()
+    x = -highpass_response(kf.a, kf.dt, hyper["frequency"], hyper["damping"])[m]
+    coef, *_ = np.linalg.lstsq(x[:, None], y, rcond=None)
+    assert coef[0] > 0 and share == pytest.approx(1.0 - np.sum((y - x * coef[0]) ** 2) / np.sum(y ** 2), rel=1e-9)
+    assert flexibility.residual_shares(kf, model, [hyper, hyper]) == pytest.approx([share, share], rel=1e-12)
     why = flexibility.seen(hyper, kf, model)
     assert why is not None and "lies in the fitting record's band" in why, why
     above = dict(hyper, frequency=1.1 * flexibility.band(kf)[1])

@@ -181,10 +181,10 @@ def unseen(kf, kv, model) -> str | None:
     if hv > UNSEEN_FACTOR * hf:
         return (f"a resonance above {hf:.3g} Hz (the fitting record's acceleration is the position sensor's noise "
                 f"there; the validation record's reaches {hv:.3g} Hz)")
-    shares = [(residual_share(kv, model, h), h) for h in hypers(kv, model)]
-    if not shares:
+    candidates = hypers(kv, model)
+    if not candidates:
         return None
-    s_v, h = max(shares, key=lambda sh: sh[0])
+    s_v, h = max(zip(residual_shares(kv, model, candidates), candidates), key=lambda sh: sh[0])
     if s_v < VALIDATION_SHARE:
         return None
     s_f = residual_share(kf, model, h)
@@ -212,19 +212,27 @@ def seen(hyper, kf, model) -> str | None:
 def residual_share(kin, model, hyper) -> float:
     """The share of the nominal force residual's square sum on the moving samples (about its
     mean) that the resonance ``hyper`` (frequency [Hz], damping) explains with a positive load
-    mass, the regressor of :func:`hypers`; 0 where a positive load mass fits none."""
+    mass alone (least squares on the regressor of :func:`hypers`, no constant); 0 where a
+    positive load mass fits none."""
+    return residual_shares(kin, model, [hyper])[0]
+
+
+def residual_shares(kin, model, candidates) -> list[float]:
+    """:func:`residual_share` of each resonance of ``candidates``, the residual formed once."""
     from ..kinematics import residual
     r = residual(kin, model)
     m = kin.moving & np.isfinite(r)
     if m.sum() < 2:
-        return 0.0
+        return [0.0] * len(candidates)
     y = r[m] - r[m].mean()
-    x = -highpass_response(kin.a, kin.dt, hyper["frequency"], hyper["damping"])[m]
-    xx, yy = float(x @ x), float(y @ y)
-    if xx <= 0 or yy <= 0:
-        return 0.0
-    theta = float(x @ y) / xx
-    return float(theta * (x @ y) / yy) if theta > 0 else 0.0
+    yy = float(y @ y)
+    out = []
+    for h in candidates:
+        x = -highpass_response(kin.a, kin.dt, h["frequency"], h["damping"])[m]
+        xx, xy = float(x @ x), float(x @ y)
+        # the squared correlation, where the least-squares load mass xy / xx is positive
+        out.append(xy * xy / (xx * yy) if xx > 0 and yy > 0 and xy > 0 else 0.0)
+    return out
 
 
 def design(kin, model, hyper):
