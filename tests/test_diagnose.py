@@ -435,17 +435,19 @@ def test_floor_reason_claims_numerical_precision_only_for_a_residual_at_that_lev
     assert "numerical precision" in _why(tiny, 1e-3, 0.05)
 
 
-def test_small_only_marks_a_member_that_fails_only_by_the_size_of_its_force_change():
-    """force.small_only: significant, validated, but its change of the friction force below the
-    relevance floor (or what it removes below the precision floor) -> True; failing anything else
-    as well, or nothing at all -> False."""
+def test_small_only_marks_a_member_that_fails_only_by_its_size_on_the_sliding_samples():
+    """force.small_only: significant, but its change of the friction force below the relevance
+    floor (or what it removes below the precision floor), or its validation gain below min_gain,
+    or both -> True; failing anything else as well, or nothing at all -> False."""
     from hunting.diagnose.force import small_only
     small = dict(p_value=1e-6, gain=0.3, rms=0.5, rms_without=0.8, floor=1e-4, change=0.01, relevance=0.04)
     assert small_only(small, 1e-3, 0.05, 0.01)
     assert small_only(dict(small, change=1.0, rms_without=0.50005), 1e-3, 0.05, 0.01)   # the precision floor
     assert not small_only(dict(small, change=1.0), 1e-3, 0.05, 0.01)                     # it passes the rule
     assert not small_only(dict(small, p_value=0.5), 1e-3, 0.05, 0.01)                    # not significant too
-    assert not small_only(dict(small, gain=0.01), 1e-3, 0.05, 0.01)                      # no validation gain too
+    assert small_only(dict(small, gain=0.01), 1e-3, 0.05, 0.01)                          # no validation gain too
+    assert small_only(dict(small, change=1.0, gain=0.01), 1e-3, 0.05, 0.01)              # the gain alone
+    assert not small_only(dict(small, gain=0.01, p_value=0.5), 1e-3, 0.05, 0.01)         # and not significant
     assert not small_only(dict(small, p_reference=0.5), 1e-3, 0.05, 0.01)                # reference fails too
 
 

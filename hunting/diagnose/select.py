@@ -459,10 +459,10 @@ def _loop_confirmation(fc: dict, fit: Measurement, validate: Measurement) -> dic
 
 def _small_on_loop(rows: list, rejected: list, base: NominalModel, fit: Measurement,
                    validate: Measurement) -> tuple | None:
-    """Where no channel named anything: the force-channel causes rejected only for the size of
-    their force change (``rows``, ``small_only``: significant out of sample and with their
-    validation gain, but changing the friction force on the sliding samples by less than the
-    relevance floor) judged on the loop at the coefficients the force channel fitted
+    """Where no channel named anything: the force-channel causes rejected only for their size on
+    the sliding samples (``rows``, ``small_only``: significant out of sample, but changing the
+    friction force there by less than the relevance floor or the validation residual by less than
+    the gain the rule asks) judged on the loop at the coefficients the force channel fitted
     (:func:`_confirmed_on_loop`). A change that small on the samples that slide can still move a
     loop that sticks and slips: a Stribeck dip acts at the break-away, which the force balance
     leaves out. Only these rows ask the loop, so a record whose sliding samples show nothing pays
