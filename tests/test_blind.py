@@ -521,6 +521,20 @@ def test_a_stribeck_change_with_too_little_validation_gain_is_named_from_the_loo
     assert r["causes"][0]["p_value"] is None
 
 
+def test_a_resonance_on_validation_blocks_with_few_sliding_samples_each_is_searched(tmp_path):
+    """reporting55 d0489 (development set since): a 23.2 Hz resonance the fitting record's motion
+    does not excite (the validation record's best candidate explains 81 % of its force residual).
+    Its validation record slides over 1115 samples, its even blocks over 444: held to 512 sliding
+    samples per block, the resonance was not searched and nothing was named. The blocks share the
+    whole record's spectrum, and the count is the whole record's: named, frequency within 10 %."""
+    generate.write("reporting55", tmp_path, indices=[489], progress=False)
+    dd = tmp_path / "d0489"
+    r = run.judge_hunting(dd)
+    assert [c["name"] for c in r["causes"]] == ["flexibility"], (r["causes"], r["rejected"])
+    truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
+    assert r["causes"][0]["parameters"]["frequency"] == pytest.approx(truth["frequency"], rel=0.1)
+
+
 def test_a_dwell_growth_in_a_valley_away_from_the_loop_grids_best_time_is_found_on_a_line_there(tmp_path):
     """reporting53 d0422 (development set since): a 1.31 N dwell growth over 31 ms. The loop's
     error has two valleys along the gain: at the grid's best time, 0.41 s, the fine line reached

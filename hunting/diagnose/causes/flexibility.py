@@ -17,6 +17,7 @@ UNITS = {"load_mass": "kg", "frequency": "Hz", "damping": "", "stiffness": "N/m"
 DAMPING = (0.02, 0.05, 0.1, 0.2, 0.4)
 DAMPING_MAX = (0.002, 1.0)            # the damping ratios the refinement may reach
 NOISE_MARGIN = 100.0                  # the acceleration power above the encoder noise's, in the band
+MIN_SLIDING = 512                     # a record's sliding samples needed to test a resonance
 SCAN_PER_OCTAVE = 4                   # the band scan's frequencies per octave (hypers)
 SCAN_BOX = (1.2, 2.0)                 # a scan candidate's range: frequency and damping ratio within these factors
 # the validation band's top over the fitting band's above which the fitting record cannot show a
@@ -157,8 +158,13 @@ def hyper_bounds(kin, model) -> dict:
 
 
 def untestable(kin, model) -> str | None:
-    if (kin.moving & np.isfinite(kin.a)).sum() < 512:
-        return "fewer than 512 sliding samples"
+    """Why a record cannot test a resonance: fewer than MIN_SLIDING sliding samples (those of the
+    record its alternate blocks are cut from, ``kin.spectrum``, where given: the blocks share its
+    spectrum and band, and each holds about half of its samples), or no band above the sensor's
+    noise (:func:`band`)."""
+    used = kin.moving if kin.spectrum is None else kin.spectrum
+    if (used & np.isfinite(kin.a)).sum() < MIN_SLIDING:
+        return f"fewer than {MIN_SLIDING} sliding samples"
     lo, hi = band(kin)
     if hi < 2 * lo:
         return (f"above {hi:.3g} Hz the measured acceleration is the position sensor's noise: no band to see a "
