@@ -1131,20 +1131,24 @@ def test_shape_gain_is_the_validation_gain_of_the_best_non_negative_multiple():
 
 
 @pytest.mark.parametrize("index, cause, words", [
-    (241, "delay", "along the noise-free loop its part explains 0."),
-    (51, "lag", "delay, lag together explain 0.0%")])
+    (241, "delay", ("along the noise-free loop its part explains 0.",
+                    "its prediction along the reference trajectory does not explain the validation data")),
+    (51, "lag", ("delay, lag together explain 0.0%",))])
 def test_noise_fed_cause_must_explain_along_the_noise_free_loop(index, cause, words):
     """Clean records of reporting13, each with a noise-fed cause that passed every earlier test.
     d0241: a 5.1 ms delay, validation gain 29 % and p < 1e-40 on the measured regressor, which
     feedback fills with the actuator's noise; along the noise-free loops its shape explains 0.3 %,
-    and its p_reference (0.006) passed by chance. d0051: a delay and a lag fitted against each
-    other, each explaining 30 % of the validation residual beside the other's measured part;
-    together along the reference they explain nothing."""
+    and its p_reference (0.006) passed by chance. Since the forty-first session (the resonance's
+    candidates changed the set it is judged in) its p_reference is 0.016 and it fails there first:
+    either is the noise-free loop's verdict. d0051: a delay and a lag fitted against each other,
+    each explaining 30 % of the validation residual beside the other's measured part; together
+    along the reference they explain nothing."""
     fit, val, model, truth = _dataset("reporting13", index)
     assert truth["effects"] == []
     d = diagnose(fit, model, val, behaviour=False)
     assert d.causes == [], [(c.name, c.parameters) for c in d.causes]
-    assert words in next(r for r in d.rejected if r["name"] == cause)["reason"]
+    reason = next(r for r in d.rejected if r["name"] == cause)["reason"]
+    assert any(w in reason for w in words), reason
 
 
 @pytest.mark.parametrize("family, index, name, key, rel", [("reporting15", 439, "level", "scale", 0.03),
