@@ -245,8 +245,9 @@ def residual_shares(kin, model, candidates) -> list[float]:
 def design_acceleration(kin) -> np.ndarray:
     """H_a of the instantaneous acceleration, stuck samples included (n,) [m/s^2]: on the moving
     samples, which lie half a filter window from every stick or break-away (H_a's reach), the
-    resonance response of it is :func:`design`'s regressor (to 1 % of its peak on reporting55 d0419),
-    one filter pass for every candidate. The masked acceleration ``kin.a`` is not: it drops the
+    resonance response of it is :func:`design`'s regressor (to rounding on reporting52 d0433; to
+    1.1 % of its peak on reporting55 d0419, whose break-away chatters, and the resonance's memory
+    carries those samples into the slide), one filter pass for every candidate. The masked acceleration ``kin.a`` is not: it drops the
     motion of the samples a break-away's chatter labels stuck, whose ringing the load still
     carries into the slide (d0419, an 18.8 Hz resonance: its regressor explained 65 % of the
     validation record's even blocks against 90 % for this one, and the search's candidate there,
