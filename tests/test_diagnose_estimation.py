@@ -455,6 +455,24 @@ def test_a_resonance_above_the_loop_bandwidth_is_found():
     assert d.causes[0].parameters["frequency"] == pytest.approx(true["frequency"], rel=0.05)
 
 
+def test_the_peak_grid_steps_within_a_light_resonances_bandwidth():
+    """flexibility._peak_factors: the grid spans PEAK_SPAN about a spectral peak in steps of at
+    most the damping ratio (half the half-power bandwidth 2 zeta f), so a resonance at damping
+    0.025 has a grid point within 1.3 % of its frequency wherever its peak lies; at least three
+    points at heavy damping."""
+    from hunting.diagnose.causes import flexibility
+
+    lo, hi = flexibility.PEAK_SPAN
+    for zeta in (0.01, 0.025, 0.05, 0.1, 0.2, 0.4, 1.0):
+        s = flexibility._peak_factors(zeta)
+        assert s[0] == pytest.approx(lo) and s[-1] == pytest.approx(hi)
+        assert s.size >= 3
+        assert np.max(np.diff(s)) <= zeta + 1e-12
+    s = flexibility._peak_factors(0.025)
+    for x in np.linspace(lo, hi, 101):
+        assert np.min(np.abs(s - x)) <= 0.0125 + 1e-12
+
+
 def test_the_band_scan_keeps_the_best_grid_point_of_each_damping_ratio():
     """flexibility._scan on a criterion with its minimum at 14.8 Hz and damping 0.1, inf (no
     positive load mass) below 5 Hz: per damping ratio of DAMPING the grid frequency nearest the
