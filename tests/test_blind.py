@@ -38,6 +38,14 @@ def _advance(plant: Plant, x, st, length, fa, rtol=1e-12):
     assert status == sim.OK
 
 
+def _judged(tmp_path, family: str, index: int):
+    """(hunting's result, the dataset's directory) of dataset ``index`` of blind ``family``,
+    generated under tmp_path."""
+    generate.write(family, tmp_path, indices=[index], progress=False)
+    dd = tmp_path / f"d{index:04d}"
+    return run.judge_hunting(dd), dd
+
+
 def test_generator_imports_nothing_from_hunting():
     """Independence: the generator's modules import no hunting code (the judge may)."""
     for name in GENERATOR:
@@ -431,9 +439,7 @@ def test_bristles_state_their_stiffness_with_the_damping_the_loop_chose(tmp_path
     their damping ratio chosen on the loop with sigma0. Read at the chosen damping alone, its
     uncertainty put the truth 2.6 of them off; the stiffness and damping's joint uncertainty
     covers it within 2."""
-    generate.write("reporting46", tmp_path, indices=[407], progress=False)
-    dd = tmp_path / "d0407"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting46", 407)
     named = {c["name"]: c for c in r["causes"]}
     assert "presliding" in named, r["causes"]
     c = named["presliding"]
@@ -448,9 +454,7 @@ def test_bristles_whose_creep_fit_fails_out_of_sample_are_judged_on_the_loop(tmp
     creep at the damping ratio creep cannot fix made the validation record's position error worse
     (-1 %), and the bristles were rejected. Judged then by the loop evidence, as where no creep
     shows, they are named beside the saturation, sigma0 within 10 %."""
-    generate.write("reporting47", tmp_path, indices=[585], progress=False)
-    dd = tmp_path / "d0585"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting47", 585)
     named = {c["name"]: c for c in r["causes"]}
     assert {"saturation", "presliding"} <= set(named), r["causes"]
     truth = {e["cause"]: e["params"] for e in json.loads((dd / "truth.json").read_text())["effects"]}
@@ -464,9 +468,7 @@ def test_a_curve_change_the_one_way_fitting_record_extrapolates_is_decided_on_th
     validation record's alternate blocks, searched for the level the fitting record cannot test,
     chose the Stribeck change that nests it. Decided there like the level, it is named, its
     Coulomb level within 10 %."""
-    generate.write("reporting51", tmp_path, indices=[331], progress=False)
-    dd = tmp_path / "d0331"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting51", 331)
     assert [c["name"] for c in r["causes"]] == ["stribeck"], r["causes"]
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     assert r["causes"][0]["parameters"]["Fc"] == pytest.approx(truth["Fc"], rel=0.1)
@@ -479,9 +481,7 @@ def test_a_dwell_growth_whose_gain_valley_the_loop_grid_steps_over_is_found_on_a
     than the grid's step: from the grid's best point Nelder-Mead stopped at 0.53 N (45 % of the
     fitting record's error cut, 50 % needed). A fine line in the gain at that point's time first
     finds the valley, and the growth is named."""
-    generate.write("reporting51", tmp_path, indices=[422], progress=False)
-    dd = tmp_path / "d0422"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting51", 422)
     assert [c["name"] for c in r["causes"]] == ["dwell"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     assert r["causes"][0]["parameters"]["gain"] == pytest.approx(truth["gain"], rel=0.3)
@@ -494,9 +494,7 @@ def test_a_stribeck_dip_too_small_on_the_sliding_samples_is_named_from_the_loop_
     sliding samples by 0.017 N RMS, below the relevance floor (0.04 N): nothing was named. At its
     fitted values the re-simulated loop follows both records far better (the exact change: 100 %
     of both position errors), so it is named, its levels within 1 %."""
-    generate.write("reporting48", tmp_path, indices=[429], progress=False)
-    dd = tmp_path / "d0429"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting48", 429)
     assert [c["name"] for c in r["causes"]] == ["stribeck"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     got = r["causes"][0]["parameters"]
@@ -511,9 +509,7 @@ def test_a_stribeck_change_with_too_little_validation_gain_is_named_from_the_loo
     the validation residual by 2.3 % (5 % needed): the break-away it acts at is not among the
     sliding samples. At its fitted values the re-simulated loop follows both records about 90 %
     better, so it is named, Fs within 1 %, its evidence the loop's."""
-    generate.write("reporting55", tmp_path, indices=[373], progress=False)
-    dd = tmp_path / "d0373"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting55", 373)
     assert [c["name"] for c in r["causes"]] == ["stribeck"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     got = r["causes"][0]["parameters"]
@@ -527,9 +523,7 @@ def test_a_resonance_on_validation_blocks_with_few_sliding_samples_each_is_searc
     Its validation record slides over 1115 samples, its even blocks over 444: held to 512 sliding
     samples per block, the resonance was not searched and nothing was named. The blocks share the
     whole record's spectrum, and the count is the whole record's: named, frequency within 10 %."""
-    generate.write("reporting55", tmp_path, indices=[489], progress=False)
-    dd = tmp_path / "d0489"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting55", 489)
     assert [c["name"] for c in r["causes"]] == ["flexibility"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     assert r["causes"][0]["parameters"]["frequency"] == pytest.approx(truth["frequency"], rel=0.1)
@@ -541,9 +535,7 @@ def test_a_dwell_growth_in_a_valley_away_from_the_loop_grids_best_time_is_found_
     54 % of the fitting record's error cut and 1 % of the validation record's. A line at each of
     the grid's times finds the other one, at its shortest time, 90 ms: named, the gain within
     10 %."""
-    generate.write("reporting53", tmp_path, indices=[422], progress=False)
-    dd = tmp_path / "d0422"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting53", 422)
     assert [c["name"] for c in r["causes"]] == ["dwell"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     assert r["causes"][0]["parameters"]["gain"] == pytest.approx(truth["gain"], rel=0.1)
@@ -558,9 +550,7 @@ def test_a_resonance_the_blocks_choose_in_place_of_the_fitting_records_mass_is_n
     resonance from the nominal model, not the mass; judged together there the mass is dropped as
     the fitting record's reading of it: the resonance is named, load mass and frequency within
     10 %."""
-    generate.write("reporting55", tmp_path, indices=[349], progress=False)
-    dd = tmp_path / "d0349"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting55", 349)
     assert [c["name"] for c in r["causes"]] == ["flexibility"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     got = r["causes"][0]["parameters"]
@@ -579,9 +569,7 @@ def test_a_level_the_one_way_fitting_record_read_as_a_viscous_change_is_decided_
     viscous change was named. Judged together from the nominal model on the blocks, the viscous
     change is dropped as the fitting record's reading and the curve change named, its Coulomb
     level within 1 %."""
-    generate.write("reporting56", tmp_path, indices=[397], progress=False)
-    dd = tmp_path / "d0397"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting56", 397)
     assert [c["name"] for c in r["causes"]] == ["stribeck"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     assert r["causes"][0]["parameters"]["Fc"] == pytest.approx(truth["Fc"], rel=0.01)
@@ -597,9 +585,7 @@ def test_a_stribeck_velocity_too_small_on_the_sliding_samples_is_fitted_on_the_l
     needed on both): nothing was named. Fitted on the fitting record's loop in its one-parameter
     forms, the velocity's form passes on both records: named, vs within 10 %, its evidence the
     loop's."""
-    generate.write("reporting56", tmp_path, indices=[415], progress=False)
-    dd = tmp_path / "d0415"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, "reporting56", 415)
     assert [c["name"] for c in r["causes"]] == ["stribeck"], (r["causes"], r["rejected"])
     truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
     got = r["causes"][0]["parameters"]
