@@ -378,9 +378,7 @@ def test_the_loop_tells_a_dwell_growth_from_a_higher_static_level(tmp_path, monk
         asked.append("instead" not in out)
         return out
     monkeypatch.setattr(dwell_loop, "static_contradiction", counted)
-    generate.write(family, tmp_path, indices=[index], progress=False)
-    dd = tmp_path / f"d{index:04d}"
-    r = run.judge_hunting(dd)
+    r, dd = _judged(tmp_path, family, index)
     assert [c["name"] for c in r["causes"]][:1] == [expected], r["causes"]
     assert asked == [expected == "dwell"]         # asked once; the loop contradicted the static level or not
     if expected == "dwell":
