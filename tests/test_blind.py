@@ -616,3 +616,29 @@ def test_a_set_that_changes_the_mass_under_its_loads_share_is_not_physical(tmp_p
     truth = {e["cause"]: e["params"] for e in json.loads((dd / "truth.json").read_text())["effects"]}
     got = {c["name"]: c["parameters"] for c in r["causes"]}
     assert got["presliding"]["sigma0"] == pytest.approx(truth["reversal"]["sigma0"], rel=0.1)
+
+
+def test_a_higher_static_level_whose_dip_the_sliding_data_place_replaces_a_collapsed_stribeck_fit(tmp_path):
+    """reporting47 d0443 (development set): a Stribeck dip 0.50 N deep at 2.2 mm/s added to a
+    curve without one. The force channel's Stribeck fit collapsed the dip (Fs 0.6688 N against
+    Fc 0.6649 N, at 6 mm/s); every rest broke away about 0.5 N above it, and at that 6 mm/s a
+    static level raised by 0.5 N grew the sliding residual 70-fold, so the excess was named a
+    dwell growth beside the Stribeck fit. With the velocity fitted on the sliding samples (Fs
+    pinned by the rests) the residual shrinks by 13 %: one Stribeck cause, Fs and vs within 10 %,
+    its increments against the nominal model, the dwell growth the alternative reading."""
+    from hunting.diagnose import NominalModel, diagnose, load
+    generate.write("reporting47", tmp_path, indices=[443], progress=False)
+    dd = tmp_path / "d0443"
+    model = NominalModel.from_json(dd / "model.json")
+    d = diagnose(load(dd / "fit.npz"), model, load(dd / "val.npz"))
+    assert [c.name for c in d.causes] == ["stribeck"], d.causes
+    truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]
+    got = d.causes[0]
+    assert got.parameters["Fs"] == pytest.approx(truth["Fs"], rel=0.1)
+    assert got.parameters["vs"] == pytest.approx(truth["vs"], rel=0.1)
+    assert "fitted on the sliding samples" in got.gain["evidence"]
+    nominal = model.curve.positive
+    assert got.increments["Fs"] == pytest.approx(got.parameters["Fs"] - nominal.Fs, abs=1e-9)
+    assert d.extended_model.curve.positive.Fs == pytest.approx(got.parameters["Fs"], abs=1e-9)
+    assert d.extended_model.curve.positive.vs == pytest.approx(got.parameters["vs"], abs=1e-12)
+    assert any(a["name"] == "dwell" and a.get("replaces") == "stribeck" for a in d.alternatives), d.alternatives

@@ -287,7 +287,7 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             cause, row, ext = _own_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim, res,
                                            lambda rivals: _found_family(rivals, result))
             if cause is not None:
-                result.append(cause)
+                result = _replacing(result, cause)
                 if row is not None:                    # the other reading of the same evidence
                     fc["alternatives"] = list(fc["alternatives"]) + [row]
                 # a force-channel cause named from other evidence: its sliding-data verdict is a note
@@ -661,7 +661,10 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     with its cause's ``name``), named unless
     ``found(rivals)`` says the force channel found a cause of the family of one of the verdict's
     ``rivals`` (dwell's break-away level: a higher static level, unless the sliding data fixed the
-    curve's; :func:`_found_family`), the first reading then its alternative; or a second reading
+    curve's; :func:`_found_family`), the first reading then its alternative, or unless the second
+    reading's Stribeck velocity was fitted on the sliding data (``velocity_fitted``,
+    :func:`hunting.diagnose.causes.dwell.sliding_contradiction`: they did not fix the curve's
+    dip, and the reading replaces a force-channel cause of its name, :func:`_replacing`); or a second reading
     the first one beat, ``also``, listed as its alternative unless ``found(rivals)`` (dwell's
     resolved growth against the static level,
     :func:`hunting.diagnose.causes.dwell.resolved_growth`). A second form with a ``veto`` fails
@@ -677,7 +680,7 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
             second = veto["reason"]
         if second is None:
             v, first = v["otherwise"], None
-            if "instead" in v and not found(v.get("rivals", ())):
+            if "instead" in v and (not found(v.get("rivals", ())) or v["instead"].get("velocity_fitted")):
                 v = dict(v["instead"], alternative=_reading(v, mod.NAME, v["instead"]["name"]))
             elif "also" in v and not found(v.get("rivals", ())):
                 v = dict(v, alternative=_reading(v["also"], v["also"]["name"], mod.NAME))
@@ -698,6 +701,22 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
                   v["parameters"], v["sigma"], gain, increments=v.get("increments", {}),
                   family=getattr(CAUSES[name], "FAMILY", name)),
             v.get("alternative"), v["model"])
+
+
+def _replacing(result: list, cause: Cause) -> list:
+    """``result`` (Cause list) with ``cause`` added, in place of a cause of its name found
+    earlier: an own-channel reading judged on the model that cause extended (dwell's static level
+    with its Stribeck velocity fitted beside a force-channel Stribeck fit whose dip collapsed)
+    holds that cause's values and its own, so its parameters are the final ones, and its
+    increments against the nominal model those of the earlier cause carried on."""
+    earlier = [c for c in result if c.name == cause.name]
+    if not earlier:
+        return result + [cause]
+    old = earlier[0]
+    # a parameter the earlier cause left at the nominal value: the reading's increment is against it
+    nominal = {n: old.parameters[n] - d for n, d in old.increments.items() if n in old.parameters}
+    inc = dict(cause.increments, **{n: cause.parameters[n] - v for n, v in nominal.items() if n in cause.parameters})
+    return [c for c in result if c is not old] + [replace(cause, increments=inc)]
 
 
 def _reading(v: dict, name: str, replaces: str) -> dict:
