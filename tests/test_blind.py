@@ -642,3 +642,39 @@ def test_a_higher_static_level_whose_dip_the_sliding_data_place_replaces_a_colla
     assert d.extended_model.curve.positive.Fs == pytest.approx(got.parameters["Fs"], abs=1e-9)
     assert d.extended_model.curve.positive.vs == pytest.approx(got.parameters["vs"], abs=1e-12)
     assert any(a["name"] == "dwell" and a.get("replaces") == "stribeck" for a in d.alternatives), d.alternatives
+
+
+def test_a_controller_that_gives_the_measured_output_only_clipped_names_the_saturation(tmp_path):
+    """reporting57 d0465 (held out in the forty-second session, development since): a saturation
+    at 2.173 that the validation run reaches in few excursions, so the pile-up test gave p = 0.004
+    and it was missed. The model's controller replayed on the validation record's q and q_ref
+    misses the measured u by 136 % RMS and matches it to 0.0 % clipped at its extreme: a fact,
+    and the saturation is named at that level."""
+    from hunting.diagnose import NominalModel, load
+    from hunting.diagnose.causes import saturation
+    r, dd = _judged(tmp_path, "reporting57", 465)
+    assert [c["name"] for c in r["causes"]] == ["saturation"], r["causes"]
+    truth = json.loads((dd / "truth.json").read_text())["effects"][0]["params"]["saturation"]
+    assert r["causes"][0]["parameters"]["saturation"] == pytest.approx(truth, rel=0.01)
+    assert r["causes"][0]["p_value"] == 0.0
+    model = NominalModel.from_json(dd / "model.json")
+    free, clipped, top = saturation.replay(load(dd / "val.npz"), model)
+    assert free > 1.0 and clipped < 0.01 and top == pytest.approx(truth, rel=0.01)
+
+
+def test_a_controller_replayed_on_clean_records_gives_their_output(tmp_path):
+    """The replay evidence stays silent on clean records: the model's controller gives the
+    measured u within the rule's 10 % as it is, so no record shows a saturation (the blind test
+    subset's clean datasets)."""
+    from hunting.diagnose import NominalModel, load
+    from hunting.diagnose.causes import saturation
+    generate.write("test", tmp_path, indices=list(range(4)), progress=False)
+    for k in range(4):
+        dd = tmp_path / f"d{k:04d}"
+        assert not json.loads((dd / "truth.json").read_text())["effects"]
+        model = NominalModel.from_json(dd / "model.json")
+        records = (load(dd / "fit.npz"), load(dd / "val.npz"))
+        for meas in records:
+            free, _, _ = saturation.replay(meas, model)
+            assert free < saturation.REPLAY_MISMATCH
+        assert saturation.replay_evidence(records, model) is None

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..errors import SystemDefinitionError
+from .causes.saturation import REPLAY_MISMATCH, replay
 from .data import Measurement
 from .loop import loop_bandwidth
 from .model import NominalModel
@@ -41,7 +42,8 @@ def check_inputs(fit: Measurement, validate: Measurement, model: NominalModel) -
     return notes
 
 
-CONTROLLER_MISMATCH = 0.10   # the controller's u against the measured u, relative RMS, before a note
+# the controller's u against the measured u, relative RMS, before a note (the saturation cause's rule)
+CONTROLLER_MISMATCH = REPLAY_MISMATCH
 
 
 def check_controller(meas: Measurement, model: NominalModel) -> str | None:
@@ -69,15 +71,12 @@ def check_controller(meas: Measurement, model: NominalModel) -> str | None:
         if rest <= CONTROLLER_MISMATCH:
             return (f"{text}; without its saturation at {model.controller['saturation']:.4g} it is {rest:.1%}: the "
                     "saturation is what differs, and re-simulations clip u where the machine did not")
-    top = float(np.max(np.abs(meas.u)))
-    if top < model.controller.get("saturation", math.inf):
-        # the machine's output may be limited where the model's is not: clipped at the measured
-        # extreme, does the model's controller give the measured u?
-        clipped = controller_output(meas, dict(model.controller, saturation=top))
-        rest = float(np.sqrt(np.mean((clipped - meas.u) ** 2))) / size
-        if rest <= CONTROLLER_MISMATCH:
-            return (f"{text}; saturated at the measured extreme ±{top:.4g} it is {rest:.1%}: the machine's output is "
-                    "limited there and the model's is not (the saturation cause judges it)")
+    # the machine's output may be limited where the model's is not: clipped at the measured
+    # extreme, does the model's controller give the measured u?
+    clipped = replay(meas, model)
+    if clipped is not None and clipped[1] <= CONTROLLER_MISMATCH:
+        return (f"{text}; saturated at the measured extreme ±{clipped[2]:.4g} it is {clipped[1]:.1%}: the machine's "
+                "output is limited there and the model's is not (the saturation cause judges it)")
     return f"{text}: check the controller's {keys} and the sign and unit of u; re-simulations run a loop the machine did not"
 
 

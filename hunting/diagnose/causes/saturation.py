@@ -166,6 +166,48 @@ def beyond(u: np.ndarray, level: float) -> tuple[float, int]:
     return U, int(np.count_nonzero(a > level + tol))
 
 
+REPLAY_MISMATCH = 0.10  # the model's controller replayed against the measured u, relative RMS (guards' note too)
+
+
+def replay(meas, model) -> tuple[float, float, float] | None:
+    """(mismatch, clipped mismatch, extreme): the model's controller fed the measured q and q_ref
+    of ``meas`` (:func:`hunting.diagnose.resimulate.controller_output`) against the measured u,
+    relative RMS, as it is and saturated at the measured extreme max |u|; None without a
+    controller, a reference or a u that moves, where the replay is not finite, or where the model's
+    controller saturates at or below that extreme already."""
+    if model.controller is None or meas.q_ref is None:
+        return None
+    from ..resimulate import controller_output
+    size = float(np.sqrt(np.mean(meas.u ** 2)))
+    top = float(np.max(np.abs(meas.u))) if meas.u.size else 0.0
+    if size <= 0 or not top < model_level(model) / (1 + BEYOND):
+        return None
+    free = controller_output(meas, model.controller)
+    clipped = controller_output(meas, dict(model.controller, saturation=top))
+    if not (np.all(np.isfinite(free)) and np.all(np.isfinite(clipped))):
+        return None
+    return (float(np.sqrt(np.mean((free - meas.u) ** 2))) / size,
+            float(np.sqrt(np.mean((clipped - meas.u) ** 2))) / size, top)
+
+
+def replay_evidence(records, model) -> dict | None:
+    """The replayed controller's verdict (:func:`replay`) on the ``records`` (Measurement
+    sequence), the one with the larger mismatch first: where the model's controller misses the
+    measured u by more than REPLAY_MISMATCH as it is and by at most that saturated at the
+    measured extreme, the machine's output is limited there and the model's is not, a fact like
+    :func:`beyond` (p = 0, the statistic the mismatch as it is, ``evidence`` the words). None
+    where no record shows it."""
+    replays = [(m, r) for m in records if (r := replay(m, model)) is not None]
+    for meas, (free, clipped, top) in sorted(replays, key=lambda x: -x[1][0]):
+        if free > REPLAY_MISMATCH >= clipped:
+            return dict(statistic=free, p_value=0.0,
+                        evidence=(f"{meas.name}: the model's controller fed the measured q and q_ref gives u with "
+                                  f"{free:.0%} RMS mismatch to the measured u, saturated at its extreme ±{top:.4g} "
+                                  f"{clipped:.1%} (rule: more than {REPLAY_MISMATCH:.0%} as it is, at most that "
+                                  "saturated)"))
+    return None
+
+
 def records_output(fit, validate) -> np.ndarray:
     """The controller output of both records (n_fit + 1 + n_val,), a zero between them so that no
     excursion runs across: the pile-up test's trials. Nothing is fitted to it but the bound, the
@@ -183,7 +225,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     """The evidence: a pile-up at a bound in either record (:func:`evidence` on
     :func:`records_output`), or outputs of the fitting data
     beyond the model's saturation level (:func:`beyond`, at least MIN_AT_BOUND samples: a fact,
-    p = 0, the statistic their count). The extension: the saturation at the measured bound, or
+    p = 0, the statistic their count), or the model's controller replayed on either record giving
+    the measured u only once saturated at its extreme (:func:`replay_evidence`, a fact too). The extension: the saturation at the measured bound, or
     beyond the model's level at the largest measured |u| of both records (the final value; its
     change against the model's level the increment)."""
     from ..resimulate import position_rms_error
@@ -202,6 +245,11 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
         return dict(out, reason=f"the fitting data stay within the model's saturation level {sat:.4g} (max |u| "
                                 f"{np.max(np.abs(fit.u)):.4g}); "
                                 "the validation data go beyond it (see the note), which cannot set a level it is judged on")
+    elif (replayed := replay_evidence((fit,) if both.size == fit.u.size else (fit, validate), model)) is not None:
+        # the controller's own law says the output was clipped, where a pile-up test has few
+        # excursions to count (reporting57 d0465: p = 0.004 from the pile-up, the model's
+        # controller 136 % off the measured u on the validation record and 0.0 % clipped at 2.173)
+        out = replayed
     elif top < MIN_AT_BOUND or U <= 0:
         where = " in the two records" if both.size > fit.u.size else ""
         return dict(out, reason=f"the controller output does not pile up at a bound ({_count(top, 'sample')} at its "
