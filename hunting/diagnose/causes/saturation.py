@@ -196,15 +196,18 @@ def replay_evidence(records, model) -> dict | None:
     measured u by more than REPLAY_MISMATCH as it is and by at most that saturated at the
     measured extreme, the machine's output is limited there and the model's is not, a fact like
     :func:`beyond` (p = 0, the statistic the mismatch as it is, ``evidence`` the words). None
-    where no record shows it."""
+    where no record shows it. On the development records of reporting46-57 it held on 333 of the
+    405 with a saturation and on none of the 7227 without one, and named the saturation on four of
+    those 333 that their stored runs, on the pile-up test, had missed (reporting47 d0544, r50
+    d0572, r51 d0604, r57 d0465)."""
     replays = [(m, r) for m in records if (r := replay(m, model)) is not None]
     for meas, (free, clipped, top) in sorted(replays, key=lambda x: -x[1][0]):
         if free > REPLAY_MISMATCH >= clipped:
             return dict(statistic=free, p_value=0.0,
-                        evidence=(f"{meas.name}: the model's controller fed the measured q and q_ref gives u with "
-                                  f"{free:.0%} RMS mismatch to the measured u, saturated at its extreme ±{top:.4g} "
-                                  f"{clipped:.1%} (rule: more than {REPLAY_MISMATCH:.0%} as it is, at most that "
-                                  "saturated)"))
+                        evidence=(f"{meas.name}: the model's controller fed the measured q and q_ref gives a u "
+                                  f"{free:.0%} RMS off the measured one as it is, and {clipped:.1%} off saturated at "
+                                  f"the measured extreme ±{top:.4g} (rule: more than {REPLAY_MISMATCH:.0%} as it is, "
+                                  f"at most {REPLAY_MISMATCH:.0%} saturated)"))
     return None
 
 
