@@ -550,9 +550,9 @@ def sliding_contradiction(level: dict, model, kf, kv) -> dict:
     those sliding samples (:func:`_sliding_velocity`, Fs pinned by the rests); where that reading
     shrinks their residual by at least SLIDING_BETTER, the sliding data favour the higher static
     level and it is the reading (``velocity_fitted``). On the development records where the
-    contradiction named dwell (reporting46-57), it shrank the residual on four with a Stribeck or
-    level truth (by 13 to 53 %) and on none of the eleven true dwell records whose curve has a
-    dip (the least growth +2.3 %, reporting52 d0520).
+    contradiction named dwell (reporting46-57), it shrank the residual on three with a Stribeck
+    truth (by 13 to 53 %) and on none of the eleven true dwell records whose curve has a dip (the
+    closest -0.0 %, reporting55 d0590; then +0.1 % and +0.3 %).
 
     Only where both directions of the model's curve have a dip: the static level is then read at
     their own Stribeck velocities. Without a dip its velocity is an upper bound below the sliding
