@@ -651,7 +651,7 @@ class _Progress:
             self.k += 1
 
 
-def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolution, found=lambda names: False):
+def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolution, found=lambda names: []):
     """Judge a cause with its own evidence and gain (``CHANNEL = "own"``: dwell, saturation,
     quantization): its ``judge`` returns the statistic, p-value, fitted parameters and the
     validation metric nominal / extended, or a reason; accepted when p < alpha and the metric
@@ -664,7 +664,8 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
     curve's; :func:`_found_family`), the first reading then its alternative, or unless the second
     reading's Stribeck velocity was fitted on the sliding data (``velocity_fitted``,
     :func:`hunting.diagnose.causes.dwell.sliding_contradiction`: they did not fix the curve's
-    dip, and the reading replaces a force-channel cause of its name, :func:`_replacing`); or a second reading
+    dip) and the causes found of that family are of the reading's own name, which it replaces
+    (:func:`_replacing`); ``found`` returns those causes' names; or a second reading
     the first one beat, ``also``, listed as its alternative unless ``found(rivals)`` (dwell's
     resolved growth against the static level,
     :func:`hunting.diagnose.causes.dwell.resolved_growth`). A second form with a ``veto`` fails
@@ -680,7 +681,11 @@ def _own_channel(mod, fit, val, kf, kv, model, alpha, min_gain, can_sim, resolut
             second = veto["reason"]
         if second is None:
             v, first = v["otherwise"], None
-            if "instead" in v and (not found(v.get("rivals", ())) or v["instead"].get("velocity_fitted")):
+            rivals = found(v.get("rivals", ()))
+            # a reading whose Stribeck velocity the sliding data fitted replaces a found cause of
+            # its own name, not one of another name in its family (a level change stays)
+            if "instead" in v and (not rivals or (v["instead"].get("velocity_fitted")
+                                                  and set(rivals) == {v["instead"]["name"]})):
                 v = dict(v["instead"], alternative=_reading(v, mod.NAME, v["instead"]["name"]))
             elif "also" in v and not found(v.get("rivals", ())):
                 v = dict(v, alternative=_reading(v["also"], v["also"]["name"], mod.NAME))
@@ -726,11 +731,12 @@ def _reading(v: dict, name: str, replaces: str) -> dict:
                 gain=dict(metric=v["metric"], nominal=v["nominal"], extended=v["extended"]))
 
 
-def _found_family(names, found: list) -> bool:
-    """Whether ``found`` (Cause list) holds a cause of the family of one of ``names`` (the model
-    the finding is judged on then holds what the sliding data say of it: reporting10 d0535 and
-    d0584, a dwell effect beside a Coulomb level)."""
-    return any(c.family == getattr(CAUSES[n], "FAMILY", n) for n in names for c in found)
+def _found_family(names, found: list) -> list:
+    """The names of the causes in ``found`` (Cause list) of the family of one of ``names``, empty
+    where there is none (the model the finding is judged on then holds what the sliding data say
+    of it: reporting10 d0535 and d0584, a dwell effect beside a Coulomb level)."""
+    families = {getattr(CAUSES[n], "FAMILY", n) for n in names}
+    return [c.name for c in found if c.family in families]
 
 
 def _own_gain(v: dict) -> float:
