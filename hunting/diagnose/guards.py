@@ -73,10 +73,10 @@ def check_controller(meas: Measurement, model: NominalModel) -> str | None:
                     "saturation is what differs, and re-simulations clip u where the machine did not")
     # the machine's output may be limited where the model's is not: clipped at the measured
     # extreme, does the model's controller give the measured u?
-    clipped = replay(meas, model)
-    if clipped is not None and clipped[1] <= CONTROLLER_MISMATCH:
-        return (f"{text}; saturated at the measured extreme ±{clipped[2]:.4g} it is {clipped[1]:.1%}: the machine's "
-                "output is limited there and the model's is not (the saturation cause judges it)")
+    replayed = replay(meas, model)
+    if replayed is not None and replayed.clipped <= CONTROLLER_MISMATCH:
+        return (f"{text}; saturated at the measured extreme ±{replayed.extreme:.4g} it is {replayed.clipped:.1%}: the "
+                "machine's output is limited there and the model's is not (the saturation cause judges it)")
     return f"{text}: check the controller's {keys} and the sign and unit of u; re-simulations run a loop the machine did not"
 
 
