@@ -260,9 +260,10 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     :func:`records_output`), or outputs of the fitting data
     beyond the model's saturation level (:func:`beyond`, at least MIN_AT_BOUND samples: a fact,
     p = 0, the statistic their count), or the model's controller replayed on either record giving
-    the measured u only once saturated at its extreme (:func:`replay_evidence`, a fact too). The extension: the saturation at the measured bound, or
-    beyond the model's level at the largest measured |u| of both records (the final value; its
-    change against the model's level the increment)."""
+    the measured u only once saturated at its extreme (:func:`replay_evidence`, a fact too). The
+    extension: the saturation at the measured bound, or beyond the model's level at the largest
+    measured |u| of both records (the final value; its change against the model's level the
+    increment)."""
     from ..resimulate import position_rms_error
     both = records_output(fit, validate)
     U, top, hits, p = evidence(both)
