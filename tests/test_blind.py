@@ -46,6 +46,11 @@ def _judged(tmp_path, family: str, index: int):
     return run.judge_hunting(dd), dd
 
 
+def _truth_params(dd) -> dict:
+    """{true cause: its parameters} of the dataset in directory ``dd``."""
+    return {e["cause"]: e["params"] for e in json.loads((dd / "truth.json").read_text())["effects"]}
+
+
 def test_generator_imports_nothing_from_hunting():
     """Independence: the generator's modules import no hunting code (the judge may)."""
     for name in GENERATOR:
@@ -455,7 +460,7 @@ def test_bristles_whose_creep_fit_fails_out_of_sample_are_judged_on_the_loop(tmp
     r, dd = _judged(tmp_path, "reporting47", 585)
     named = {c["name"]: c for c in r["causes"]}
     assert {"saturation", "presliding"} <= set(named), r["causes"]
-    truth = {e["cause"]: e["params"] for e in json.loads((dd / "truth.json").read_text())["effects"]}
+    truth = _truth_params(dd)
     assert named["presliding"]["parameters"]["sigma0"] == pytest.approx(truth["reversal"]["sigma0"], rel=0.1)
 
 
@@ -600,7 +605,7 @@ def test_an_idle_member_stays_where_the_others_alone_fit_only_unphysically(tmp_p
     are named, the viscous coefficient within 10 %."""
     r, dd = _judged(tmp_path, "reporting57", 586)
     assert {c["name"] for c in r["causes"]} == {"viscous", "stribeck"}, r["causes"]
-    truth = {e["cause"]: e["params"] for e in json.loads((dd / "truth.json").read_text())["effects"]}
+    truth = _truth_params(dd)
     got = {c["name"]: c["parameters"] for c in r["causes"]}
     assert got["viscous"]["b"] == pytest.approx(truth["viscous"]["b"], rel=0.1)
 
@@ -613,7 +618,7 @@ def test_a_set_that_changes_the_mass_under_its_loads_share_is_not_physical(tmp_p
     set is not physical, and the diagnosis names the bristles and the resonance."""
     r, dd = _judged(tmp_path, "reporting46", 555)
     assert {c["name"] for c in r["causes"]} == {"presliding", "flexibility"}, r["causes"]
-    truth = {e["cause"]: e["params"] for e in json.loads((dd / "truth.json").read_text())["effects"]}
+    truth = _truth_params(dd)
     got = {c["name"]: c["parameters"] for c in r["causes"]}
     assert got["presliding"]["sigma0"] == pytest.approx(truth["reversal"]["sigma0"], rel=0.1)
 

@@ -581,14 +581,16 @@ def sliding_contradiction(level: dict, model, kf, kv) -> dict:
     return dict(named, evidence=f"{level['evidence']}; {why}", also=static)
 
 
-def _sliding_growth(model, other, kf, kv) -> tuple[float, int]:
+def _sliding_growth(model, other, kf, kv, base=None) -> tuple[float, int]:
     """The relative growth of the force residual's RMS on the sliding samples of both records
     (``kf.moving``, ``kv.moving``, where both residuals are finite) from ``model`` to ``other``,
-    and their number."""
+    and their number; ``base``: ``model``'s residuals on (kf, kv), where a caller compares many
+    models against it."""
     from ..kinematics import residual
+    base = base or [residual(k, model) for k in (kf, kv)]
     r0, r1 = [], []
-    for k in (kf, kv):
-        a, b = residual(k, model), residual(k, other)
+    for k, a in zip((kf, kv), base):
+        b = residual(k, other)
         use = k.moving & np.isfinite(a) & np.isfinite(b)
         r0.append(a[use])
         r1.append(b[use])
@@ -608,15 +610,18 @@ def _sliding_velocity(reading: dict, model, kf, kv) -> dict:
     refined by a bounded scalar search between the best point's neighbours; the excess reads
     only Fs, so the break-away metric is the reading's."""
     from scipy.optimize import minimize_scalar
+
+    from ..kinematics import residual
     from . import stribeck
     low = 0.5 * float(np.percentile(sliding_speeds(kf, kv), 2))
+    base = [residual(k, model) for k in (kf, kv)]
     theta = np.array([reading["increments"]["Fs"]])
 
     def extended(vs):
         return stribeck.extend(model, theta, {"vs": vs, "vs_neg": vs, "dip": True})
 
     def growth(log_vs):
-        return _sliding_growth(model, extended(float(np.exp(log_vs))), kf, kv)[0]
+        return _sliding_growth(model, extended(float(np.exp(log_vs))), kf, kv, base)[0]
 
     grid = np.linspace(np.log(low / 20), np.log(4 * low), VS_POINTS)
     values = [growth(x) for x in grid]
