@@ -674,11 +674,32 @@ def test_a_replay_that_goes_beyond_where_the_output_did_not_names_no_saturation(
     its last 40 % starts in motion, where the replay's start state is not the machine's: 16 % off
     as it is, 1.6 % clipped at that part's extreme, because two replayed samples went beyond an
     extreme the measured u touched once, and a saturation was named. Beyond the extreme the
-    measured u must sit at it: no saturation (the resonance, which the loop clipped by that false
-    saturation let the diagnosis find, stays missed, as before the replay)."""
+    measured u must sit at it: no saturation. And the part is now replayed and re-simulated
+    through the record before it (forty-fourth session): the replay matches the measured u there,
+    and the resonance, missed while the part was re-simulated from its own first sample, is named
+    (load mass 4.6 % low)."""
     r, dd = _judged(tmp_path, "reporting58", 405)
     assert "saturation" not in [c["name"] for c in r["causes"]], r["causes"]
     assert any(x["name"] == "saturation" for x in r["rejected"] + r["untested"])
+    assert [c["name"] for c in r["causes"]] == ["flexibility"], r["causes"]
+    truth = _truth_params(dd)["flexibility"]
+    assert r["causes"][0]["parameters"]["load_mass"] == pytest.approx(truth["load_mass"], rel=0.1)
+    assert r["causes"][0]["parameters"]["frequency"] == pytest.approx(truth["frequency"], rel=0.02)
+
+
+def test_a_part_of_the_validation_record_is_re_simulated_through_the_record_before_it(tmp_path):
+    """reporting58 d0625 (held out in the forty-third session): LuGre bristles (sigma0 555 kN/m)
+    and a Coulomb level 10 % low. The fitting record has no sliding samples, so the validation
+    record is split, and its last 40 % starts in motion. Re-simulated from that part's own first
+    sample (bristles undeflected, the controller's state guessed), the bristles fitted on the first
+    part (sigma0 518 kN/m, 88.6 % of its position error gone) made the last part's error 24 %
+    worse, and only the level was named; re-simulated through the record before it, both are
+    named, the bristles within 10 %."""
+    r, dd = _judged(tmp_path, "reporting58", 625)
+    names = [c["name"] for c in r["causes"]]
+    assert "level" in names and ("presliding" in names or "reversal" in names), r["causes"]
+    bristles = next(c for c in r["causes"] if c["name"] in ("presliding", "reversal"))
+    assert bristles["parameters"]["sigma0"] == pytest.approx(_truth_params(dd)["reversal"]["sigma0"], rel=0.1)
 
 
 def test_a_controller_replayed_on_clean_records_gives_their_output(tmp_path):

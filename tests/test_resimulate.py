@@ -2,6 +2,8 @@
 zero-order-hold discretization of a linear loop, the analytic stop of a mass under Coulomb
 friction, and the virtual linear motor's own sampled simulator (LuGre, cogging); and the
 behaviour metrics on signals with known answers."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.signal import cont2discrete
@@ -359,3 +361,43 @@ def test_a_fitted_load_at_least_the_whole_mass_is_not_physical():
     assert "<= 0" in flexibility.unphysical([-1.0], hyper, m)
     assert flexibility.unphysical([5.0], hyper, m) is None
     assert flexibility.extend(m, [5.0], hyper).flexibility.load_mass == 5.0
+
+
+def _pid_stick_slip_record():
+    """A PID loop with Stribeck friction and a dwell-free static law, tracking a ramp-and-hold
+    reference, re-simulated by the model itself (a record the model explains exactly)."""
+    n, dt = 4000, 1e-3
+    model = NominalModel.from_dict({"plant": {"mass": 1.5},
+                                    "friction": {"Fc": 1.0, "Fs": 1.4, "vs": 0.002, "b": 3.0},
+                                    "controller": {"type": "pid", "kp": 3000.0, "kd": 60.0, "ki": 20000.0}})
+    t = np.arange(n) * dt
+    r = 0.004 * np.clip(t - 0.2, 0.0, 1.0) - 0.003 * np.clip(t - 2.4, 0.0, 1.0)
+    sim = resimulate(_meas(n, dt, r), model, resolution=1e-7)
+    return Measurement(t, sim.q, sim.u, q_ref=r), model
+
+
+def test_a_part_is_re_simulated_through_the_record_before_it():
+    """A part cut out of a record in motion (the validation record's last 40 %, where the fitting
+    record cannot be fitted on) re-simulates as the record does from its start: its first sample
+    carries the controller's integral and the slip the loop had there. From the part's own first
+    sample those states are guessed, and the re-simulation leaves the record (reporting58 d0625)."""
+    from hunting.diagnose.parts import split_in_time
+    from hunting.diagnose.resimulate import controller_output
+    rec, model = _pid_stick_slip_record()
+    assert split_in_time(rec)[0].source is None                # a part from the record's start is one
+    first, last = split_in_time(rec.part(rec.t[300], rec.t[-1] + rec.dt))     # parts of a part, too
+    assert first.source is rec and last.source is rec
+    assert (first.start, last.start) == (300, int(np.argmax(rec.t >= last.t[0])))
+    whole = resimulate(rec, model, resolution=1e-7)
+    part = resimulate(last, model, resolution=1e-7)
+    assert np.array_equal(part.t, last.t)
+    assert np.array_equal(part.q, whole.q[last.start:last.start + last.n])
+    assert np.array_equal(part.u, whole.u[last.start:last.start + last.n])
+    alone = resimulate(replace(last, source=None, start=0), model, resolution=1e-7)
+    # from its own first sample the part leaves the record by 10.8 um RMS (a stroke of 4 mm) ...
+    assert np.sqrt(np.mean((alone.q - last.q) ** 2)) > 1e-6
+    u = controller_output(last, model.controller)
+    assert np.array_equal(u, controller_output(rec, model.controller)[last.start:last.start + last.n])
+    # ... and the controller replayed from there misses the record's u by 15 % RMS
+    u_alone = controller_output(replace(last, source=None, start=0), model.controller)
+    assert np.sqrt(np.mean((u_alone - last.u) ** 2)) > 0.05 * np.sqrt(np.mean(last.u ** 2))

@@ -10,7 +10,7 @@ injection, not a force on the load); ``names={"u_inj": None}`` leaves a column o
 from __future__ import annotations
 
 import csv
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +28,9 @@ class Measurement:
     """Sampled signals, one row per sample (uniform sampling required). t [s]; q [m or rad];
     u [V or N] (what drove the plant, injections included); q_ref, f_ext : optional arrays;
     u_inj : optional known signal added to the controller output (an injected test signal, in
-    u's unit; part of u, so only re-simulation uses it); name : where they came from."""
+    u's unit; part of u, so only re-simulation uses it); name : where they came from; source,
+    start : for a part cut out of a longer record (:meth:`part`), that record and the index of
+    the part's first sample in it (None, 0 otherwise)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -37,6 +39,8 @@ class Measurement:
     f_ext: np.ndarray | None = None
     name: str = "data"
     u_inj: np.ndarray | None = None
+    source: "Measurement | None" = field(default=None, repr=False, compare=False)
+    start: int = 0
 
     def __post_init__(self):
         n = np.asarray(self.t).size
@@ -80,10 +84,27 @@ class Measurement:
         return np.zeros(self.n) if self.f_ext is None else self.f_ext
 
     def part(self, start: float, stop: float) -> "Measurement":
-        """The samples with start <= t < stop [s]."""
+        """The samples with start <= t < stop [s]. A part that starts after the record's first
+        sample keeps the record as its ``source`` (:meth:`from_record_start`)."""
         sel = (self.t >= start) & (self.t < stop)
         kw = {k: (None if getattr(self, k) is None else getattr(self, k)[sel]) for k in REQUIRED + OPTIONAL}
-        return replace(self, **kw, name=f"{self.name}[{start:g}:{stop:g}]")
+        first = int(np.argmax(sel)) if sel.any() else 0
+        root, at = (self.source, self.start + first) if self.source is not None else (self, first)
+        return replace(self, **kw, name=f"{self.name}[{start:g}:{stop:g}]", source=root if at > 0 else None,
+                       start=at if at > 0 else 0)
+
+    def from_record_start(self) -> "Measurement":
+        """The record this part was cut from, from its first sample through the part's last
+        (itself when it is not a part): what a re-simulation of the part runs through, so that the
+        part starts from the state the loop had there (a part that starts in motion, re-simulated
+        from its own first sample, starts from guessed controller and friction states:
+        reporting58 d0405, d0625)."""
+        if self.source is None:
+            return self
+        end = self.start + self.n
+        kw = {k: (None if getattr(self.source, k) is None else getattr(self.source, k)[:end])
+              for k in REQUIRED + OPTIONAL}
+        return replace(self.source, **kw, source=None, start=0)
 
 
 def _pick(found: dict, names: dict | None, path: Path) -> dict:
