@@ -401,23 +401,3 @@ def test_a_part_is_re_simulated_through_the_record_before_it():
     # ... and the controller replayed from there misses the record's u by 15 % RMS
     u_alone = controller_output(replace(last, source=None, start=0), model.controller)
     assert np.sqrt(np.mean((u_alone - last.u) ** 2)) > 0.05 * np.sqrt(np.mean(last.u ** 2))
-
-
-def test_lugre_bristles_of_a_record_that_starts_in_motion_start_at_their_sliding_deflection():
-    """A LuGre loop record cut at 4 mm/s, re-simulated from its own first sample (no record
-    before it to run through): the bristles start at their sliding deflection g(|v|) / sigma0, so
-    the run follows the record within 1 um over the first 50 samples. Started undeflected (no
-    friction at first) it left the record by 10.5 um."""
-    n, dt = 4000, 1e-3
-    model = NominalModel.from_dict({"plant": {"mass": 1.5},
-                                    "friction": {"law": "lugre", "Fc": 1.0, "Fs": 1.4, "vs": 0.002, "b": 3.0,
-                                                 "sigma0": 2e5, "sigma1": 500.0},
-                                    "controller": {"type": "pid", "kp": 3000.0, "kd": 60.0, "ki": 20000.0}})
-    t = np.arange(n) * dt
-    r = 0.004 * np.clip(t - 0.2, 0.0, 1.0)
-    sim = resimulate(_meas(n, dt, r), model, resolution=1e-7)
-    k = 700
-    assert sim.v[k] == pytest.approx(0.004, rel=0.05)
-    part = Measurement(t[k:], sim.q[k:], sim.u[k:], q_ref=r[k:])
-    alone = resimulate(part, model, resolution=1e-7)
-    assert np.max(np.abs(alone.q[:50] - part.q[:50])) < 1e-6

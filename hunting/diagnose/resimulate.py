@@ -467,16 +467,10 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
     I0, sig0 = _controller_start(ctrl, c, meas, inj)
     z0 = 0.0
     if model.law == "lugre":
-        # at rest the bristles carry the force that holds the mass (quasi-static); in motion they
-        # are at their sliding deflection (undeflected, friction started at zero: a loop record cut
-        # in motion at 4 mm/s left the record by 10.5 um within 50 samples, 0.9 um so)
+        # the bristles carry the force that holds the mass at the start (quasi-static)
         pos, neg = model.curve.positive, model.curve.negative
-        if at_rest:
-            need = model.cm * u0 + fext[0] - model.offset - float(model.cogging_force(q0))
-            z0 = float(np.clip(need, -0.99 * neg.Fs, 0.99 * pos.Fs)) / model.sigma0
-        else:
-            c0 = pos if v0 >= 0 else neg
-            z0 = float(np.sign(v0) * c0.level(np.array([abs(v0)]))[0]) / model.sigma0
+        need = model.cm * u0 + fext[0] - model.offset - float(model.cogging_force(q0))
+        z0 = float(np.clip(need, -0.99 * neg.Fs, 0.99 * pos.Fs)) / model.sigma0 if at_rest else 0.0
     elif model.lag > 0:
         # the lagging Stribeck level starts where it settles: Fs at rest, g(|v0|) when moving
         c0 = model.curve.positive if v0 >= 0 else model.curve.negative
