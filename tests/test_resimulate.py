@@ -401,3 +401,8 @@ def test_a_part_is_re_simulated_through_the_record_before_it():
     # ... and the controller replayed from there misses the record's u by 15 % RMS
     u_alone = controller_output(replace(last, source=None, start=0), model.controller)
     assert np.sqrt(np.mean((u_alone - last.u) ** 2)) > 0.05 * np.sqrt(np.mean(last.u ** 2))
+    # the part's own samples are its, not the record's: a part given another reference runs on it
+    moved = replace(last, q_ref=last.q_ref + 1e-4)
+    through = moved.from_record_start()
+    assert np.array_equal(through.q_ref[:last.start], rec.q_ref[:last.start])
+    assert np.array_equal(through.q_ref[last.start:], moved.q_ref)

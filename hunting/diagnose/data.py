@@ -101,9 +101,12 @@ class Measurement:
         reporting58 d0405, d0625)."""
         if self.source is None:
             return self
-        end = self.start + self.n
-        kw = {k: (None if getattr(self.source, k) is None else getattr(self.source, k)[:end])
-              for k in REQUIRED + OPTIONAL}
+        kw = {}
+        for k in REQUIRED + OPTIONAL:           # the record's samples before the part, then the part's own
+            before, own = getattr(self.source, k), getattr(self, k)
+            kw[k] = None if before is None and own is None else np.concatenate(
+                [np.zeros(self.start) if before is None else before[:self.start],
+                 np.zeros(self.n) if own is None else own])
         return replace(self.source, **kw, source=None, start=0)
 
 

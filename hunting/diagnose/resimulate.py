@@ -424,7 +424,8 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
     bristle deflection; the default carries the force the first measured u applies);
     sensor_noise [m] : standard deviation of the position noise before quantization (default: the
     model's ``sensor`` noise, else 0; near rest it dithers the controller output, which moves a
-    LuGre contact), drawn with ``seed``."""
+    LuGre contact), drawn with ``seed``. A part of a record (``meas.source``, :meth:`Measurement.part`)
+    is run from the record's first sample and its own samples returned (unless x0 is given)."""
     ctrl_d = controller if controller is not None else model.controller
     if ctrl_d is None:
         raise SystemDefinitionError("the model has no 'controller': re-simulation needs one (see the MODEL.json schema)")
@@ -512,7 +513,8 @@ def _controller_start(ctrl: SampledController, c: np.ndarray, meas: Measurement,
 def controller_output(meas: Measurement, controller: dict) -> np.ndarray:
     """The output u (n,) of the ``controller`` (the MODEL.json schema) fed the measured q and
     q_ref of ``meas`` (its injection u_inj added, saturation and DAC step applied), from the state
-    whose first output is the measured u[0]: what the model's controller would have sent."""
+    whose first output is the measured u[0]: what the model's controller would have sent. A part
+    of a record is replayed from the record's first sample."""
     if meas.q_ref is None:
         raise SystemDefinitionError(f"{meas.name}: the controller's output needs the reference column q_ref")
     if meas.source is not None:          # a part: replayed through the record before it (resimulate)
