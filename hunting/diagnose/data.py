@@ -90,8 +90,7 @@ class Measurement:
         kw = {k: (None if getattr(self, k) is None else getattr(self, k)[sel]) for k in REQUIRED + OPTIONAL}
         first = int(np.argmax(sel)) if sel.any() else 0
         root, at = (self.source, self.start + first) if self.source is not None else (self, first)
-        return replace(self, **kw, name=f"{self.name}[{start:g}:{stop:g}]", source=root if at > 0 else None,
-                       start=at if at > 0 else 0)
+        return replace(self, **kw, name=f"{self.name}[{start:g}:{stop:g}]", source=root if at > 0 else None, start=at)
 
     def from_record_start(self) -> "Measurement":
         """The record this part was cut from, from its first sample through the part's last

@@ -439,7 +439,6 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
         resolution = model.resolution
     res = resolution_of(meas.q) if resolution is None else check_finite_positive("resolution", resolution,
                                                                                  allow_zero=True)
-    p, cog, bases = model_arrays(model)
     fext = meas.force_ext() + (0.0 if force_noise is None else np.asarray(force_noise, float))
     if fext.shape != (meas.n,):
         raise SystemDefinitionError(f"force_noise must have {meas.n} samples")
@@ -453,6 +452,7 @@ def resimulate(meas: Measurement, model: NominalModel, *, controller: dict | Non
         sim = resimulate(whole, model, controller=ctrl_d, substeps=substeps, resolution=res, force_noise=noise,
                          sensor_noise=sensor_noise, seed=seed)
         return sim.tail(meas.start)
+    p, cog, bases = model_arrays(model)
     q0 = float(meas.q[0])
     k = min(5, meas.n - 1)
     secant = float((meas.q[k] - meas.q[0]) / (k * dt))
