@@ -115,3 +115,32 @@ def test_creep_below_the_moving_bound_stays_a_stick():
     creep = (t > 0.65) & (t < 0.85)
     assert record(10 * slow).slide[creep].all()
     assert not record(100 * slow).slide[creep].any()
+
+
+@pytest.mark.parametrize("shape, w", [((2000,), 21), ((2000, 3), 41), ((30,), 21), ((15, 2), 21)])
+def test_the_acceleration_filter_is_scipys_savitzky_golay_second_derivative(shape, w):
+    """H_a applies scipy's savgol_filter (cubic, second derivative, mode 'interp') to the double
+    sum, as a linear operator read once from that filter: the same output as the filter itself,
+    interior and edges, on single and multi-column inputs, and the filter's own on inputs shorter
+    than the window (its error: 15 samples under 21)."""
+    from scipy.signal import savgol_filter
+
+    from hunting.diagnose.kinematics import acceleration_filter
+    rng = np.random.default_rng(3)
+    dt = 1e-3
+    x = rng.normal(size=shape) + np.linspace(0.0, 5.0, shape[0]).reshape((-1,) + (1,) * (len(shape) - 1))
+    m = np.mean(x, axis=0)
+    y = np.cumsum(x - m, axis=0) * dt
+    X = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(y, axis=0)[:-1]], axis=0) * dt
+    if shape[0] < w:
+        with pytest.raises(ValueError):
+            acceleration_filter(x, dt, w)
+        return
+    want = savgol_filter(X, w, 3, deriv=2, delta=dt, mode="interp", axis=0) + m
+    got = acceleration_filter(x, dt, w)
+    assert got.shape == x.shape
+    assert np.allclose(got, want, rtol=0.0, atol=1e-9 * np.max(np.abs(want)))
+    # and it is the second derivative's low pass: a parabola's second derivative exactly
+    t = np.arange(shape[0]) * dt
+    assert np.allclose(acceleration_filter(np.full(shape[0], 2.0), dt, w), 2.0)
+    assert np.allclose(savgol_filter(t ** 2, w, 3, deriv=2, delta=dt, mode="interp"), 2.0)

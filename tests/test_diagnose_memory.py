@@ -579,3 +579,17 @@ def test_dwell_growth_at_the_fits_rounding_does_not_fall(gain, words, monkeypatc
     F, s = np.full(8, 22.3), np.ones(8)
     v = dwell._growth_verdict(t, F, s, s, t[:4], F[:4], s[:4], s[:4], model)
     assert words in v["reason"]
+
+
+def test_dwell_reading_gain_is_the_least_squares_growth_of_the_readings():
+    """The loop fit's start from break-away readings: at a given growth time, the gain of
+    e_k ~ gain (1 - exp(-t_k / time)) by least squares (the exact gain on exact readings,
+    numpy's lstsq on noisy ones), 0 without readings."""
+    from hunting.diagnose.causes import dwell_loop
+    t = np.array([0.05, 0.2, 0.4, 1.2])
+    e = 3.0 * (1 - np.exp(-t / 0.1))
+    assert dwell_loop.reading_gain(t, e, 0.1) == pytest.approx(3.0, rel=1e-12)
+    noisy = e + np.array([0.2, -0.1, 0.3, -0.25])
+    want = np.linalg.lstsq((1 - np.exp(-t / 0.3))[:, None], noisy, rcond=None)[0][0]
+    assert dwell_loop.reading_gain(t, noisy, 0.3) == pytest.approx(want, rel=1e-12)
+    assert dwell_loop.reading_gain(np.array([]), np.array([]), 0.1) == 0.0

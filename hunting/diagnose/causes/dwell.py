@@ -361,7 +361,8 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
             # the time grid spans the rests whose length is known (the first one's is a lower
             # bound, often the whole preamble: with it the grid's times ran long and the fit missed
             # reporting28 d0586's 0.22 s growth, validation -15 %; with the three later rests, +85 %)
-            loop = dwell_loop.unprompted(fit, validate, model, t if t.size else held, _unasked(out))
+            loop = dwell_loop.unprompted(fit, validate, model, t if t.size else held, _unasked(out),
+                                         readings=(t, excess(model, t, F, s)) if t.size else None)
     return out if loop is None else dict(out, otherwise=loop)
 
 
