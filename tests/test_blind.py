@@ -713,6 +713,18 @@ def test_a_growth_the_grid_misses_is_fitted_from_its_break_away_reading(tmp_path
     assert r["causes"][0]["parameters"]["gain"] == pytest.approx(_truth_params(dd)["dwell"]["gain"], rel=0.1)
 
 
+def test_a_growth_beside_bristles_the_loop_named_is_judged_without_them(tmp_path):
+    """reporting60 d0464 (held out in the forty-fourth session): a 0.69 N dwell growth over 75 ms
+    on Fs 5.3 N. The stick channel named LuGre bristles from the loop alone (validation error cut
+    by 64 %), and the growth, judged on their extension, whose re-simulation has no rest for it to
+    act on, cut 0 %. Judged on the model without them it cuts that error by 86 %: the growth is
+    named, its gain within 10 %, and the bristles are its alternative reading."""
+    r, dd = _judged(tmp_path, "reporting60", 464)
+    assert [c["name"] for c in r["causes"]] == ["dwell"], (r["causes"], r["rejected"])
+    assert r["causes"][0]["parameters"]["gain"] == pytest.approx(_truth_params(dd)["dwell"]["gain"], rel=0.1)
+    assert any(a["name"] == "presliding" and a["kind"] == "same evidence" for a in r["alternatives"]), r["alternatives"]
+
+
 def test_a_controller_replayed_on_clean_records_gives_their_output(tmp_path):
     """The replay evidence stays silent on clean records: the model's controller gives the
     measured u within the rule's 10 % as it is, so no record shows a saturation (the blind test

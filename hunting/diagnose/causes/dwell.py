@@ -43,6 +43,9 @@ NAME = "dwell"
 DESCRIPTION = "break-away force growing with the time at rest"
 CHANNEL = "own"
 FAMILY = "break-away"
+# judged on the model without LuGre bristles the loop alone named: their re-simulation has no rest
+# for the growth to act on (hunting.diagnose.select._break_away_readings)
+BREAK_AWAY_ON_LOOP = True
 UNITS = {"level": "N", "gain": "N", "time": "s"}
 MIN_RESTS = 5          # fitting rests: three parameters (level, gain, time) and two degrees of freedom
 MIN_VALIDATION = 3     # validation rests for the gain
