@@ -122,7 +122,7 @@ def acceleration_filter(x: np.ndarray, dt: float, w: int) -> np.ndarray:
     y = np.cumsum(x - m, axis=0) * dt
     X = np.concatenate([np.zeros((1,) + x.shape[1:]), np.cumsum(y, axis=0)[:-1]], axis=0) * dt
     if X.shape[0] < w:
-        return savgol_filter(X, w, 3, deriv=2, delta=dt, mode="interp", axis=0) + m   # its error
+        return savgol_filter(X, w, 3, deriv=2, delta=dt, mode="interp", axis=0) + m   # scipy's error: too short
     inner, first, last = _second_derivative_operator(w, dt)
     out = convolve1d(X, inner, axis=0, mode="constant")
     h, n = w // 2, X.shape[0]
