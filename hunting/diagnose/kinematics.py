@@ -136,7 +136,7 @@ def _second_derivative_operator(w: int, dt: float) -> tuple[np.ndarray, np.ndarr
     """savgol_filter(X, w, 3, deriv=2, delta=dt, mode="interp") as a linear operator: (its
     convolution kernel (w,), the rows (w // 2, w) that give the first w // 2 outputs from the
     first w samples, those (w // 2, w) that give the last from the last w). Read from scipy's
-    filter applied to the unit vectors, so it is scipy's filter (to 1e-11 of its output's scale:
+    filter applied to the unit vectors, so it is scipy's filter (within 5e-11 of its output's scale:
     its edges refit a cubic on every call); the diagnosis filters ~700 signals per record, and
     the refits took a third of the filtering."""
     h = w // 2
