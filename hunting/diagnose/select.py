@@ -743,7 +743,8 @@ def _break_away_readings(mod, bristles, result, fit, val, kf, kv, ext, alpha, mi
     cause, row, own_ext = _own_channel(mod, fit, val, kf, kv, b_model, alpha, min_gain, can_sim, resolution, found)
     if cause is None:
         return None, row, ext, result, None
-    e_own, e_b = position_rms_error(val, own_ext), position_rms_error(val, ext)
+    # the bristles' validation error is their loop evidence's (the same run of their extension)
+    e_own, e_b = position_rms_error(val, own_ext), b_cause.gain["extended"]
     metric = "re-simulated position RMS error [m], validation"
     if e_own < e_b:
         other = dict(name=b_cause.name, kind="same evidence", replaces=cause.name, parameters=b_cause.parameters,
