@@ -593,3 +593,24 @@ def test_dwell_reading_gain_is_the_least_squares_growth_of_the_readings():
     want = np.linalg.lstsq((1 - np.exp(-t / 0.3))[:, None], noisy, rcond=None)[0][0]
     assert dwell_loop.reading_gain(t, noisy, 0.3) == pytest.approx(want, rel=1e-12)
     assert dwell_loop.reading_gain(np.array([]), np.array([]), 0.1) == 0.0
+
+
+def test_dwell_is_refused_on_a_lugre_model_whose_contact_never_rests():
+    """A LuGre model's re-simulation has no rest (the bristles' state carries the contact), so a
+    dwell growth in it would be silently left out of every run: the model file is refused with
+    the reason, the dwell verdict on a LuGre model is untestable (not a reading of break-aways
+    the bristles make), and reversal (LuGre bristles) is untestable on a model with a growth."""
+    from hunting.diagnose.causes import reversal
+    from hunting.errors import SystemDefinitionError
+    d = {"plant": {"mass": 1.0}, "friction": {"law": "lugre", "Fc": 1.0, "Fs": 2.0, "vs": 0.01, "sigma0": 1e5,
+                                              "sigma1": 300.0, "dwell": {"level": 0.0, "gain": 0.5, "time": 0.2}}}
+    with pytest.raises(SystemDefinitionError, match="friction dwell applies to the static laws.*'lugre'"):
+        NominalModel.from_dict(d)
+    meas, model, _ = _breakaway_record()
+    assert "rest ending in motion" in dwell.judge(meas, meas, None, None, model, False, 1e-6)["reason"]   # read
+    v = dwell.judge(meas, meas, None, None, model.replace(law="lugre", sigma0=1e5, sigma1=300.0), False, 1e-6)
+    assert v["untestable"] and "LuGre" in v["reason"] and "model" not in v
+    from hunting.diagnose.model import Dwell
+    kin = kinematics(meas, model.cm)
+    assert "dwell" not in (reversal.untestable(kin, model) or "")
+    assert "dwell growth" in reversal.untestable(kin, model.replace(dwell=Dwell(0.0, 0.5, 0.2)))

@@ -42,9 +42,10 @@ errors, so typos are caught). The plant is  m q'' = cm u(t - delay) + f_ext - F(
   "friction":   "law": "coulomb-viscous" | "stribeck" | "switch" | "lugre";
                 "Fc" [N] (required), "Fs" [N], "vs" [m/s], "beta", "b" [N s/m];
                 "Fc_neg", "Fs_neg", "vs_neg", "beta_neg", "b_neg" for the negative direction;
-                "sigma0" [N/m], "sigma1" [N s/m] (lugre); "lag" [s];
+                "sigma0" [N/m], "sigma1" [N s/m] (lugre); "lag" [s] (static laws);
                 "dwell": {"level": N, "gain": N, "time": s, optional "sliding": true (the
                 seven-parameter form: the slip after a rest starts from the grown force)}
+                (static laws: a LuGre contact never rests)
   "controller": {"type": "pid", "kp", "kd", "ki"} (or "form": "PDI" with "P", "D", "I", or
                 "form": "K" with "K"), optional "derivative_on": "error" | "measurement",
                 "tau_f" [s], "sample_time" [s], "saturation", "output_resolution";
@@ -199,6 +200,13 @@ class NominalModel:
             raise SystemDefinitionError("friction lag applies to the static laws; LuGre has its own memory (sigma0, sigma1)")
         if self.dwell is not None and not isinstance(self.dwell, Dwell):
             raise SystemDefinitionError(f"dwell = {self.dwell!r} must be a Dwell")
+        if self.dwell is not None and self.law == "lugre":
+            # the LuGre re-simulation has no rest (the bristles' state carries the contact), so a
+            # growth with the time at rest would be silently left out of every re-simulated run
+            raise SystemDefinitionError(
+                "friction dwell applies to the static laws: with law 'lugre' the contact never rests (the bristles' "
+                "state carries it), so a break-away growth with the time at rest has nothing to act on; give a static "
+                "law (coulomb-viscous, stribeck or switch) with dwell, or LuGre without it")
         if self.dwell is not None and self.dwell.sliding and not all(
                 c.Fs > c.Fc and not c.discontinuous for c in (self.curve.positive, self.curve.negative)):
             raise SystemDefinitionError(

@@ -265,9 +265,11 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
             untested.append(dict(name=name, reason="the force channel found frictional memory (lag), which LuGre "
                                                    "bristles would replace"))
             continue
-        if ext.dwell is not None and model.dwell is None:
-            untested.append(dict(name=name, reason="the force channel found a dwell growth (dwell_peak), which LuGre "
-                                                   "bristles' re-simulation would drop"))
+        if ext.dwell is not None:
+            untested.append(dict(name=name, reason=(
+                "the nominal model has a dwell growth" if model.dwell is not None else
+                "the force channel found a dwell growth (dwell_peak)") + ", which LuGre bristles would replace (their "
+                "contact never rests)"))
             continue
         before_stick = ext
         cause, row, ext = _stick_channel(CAUSES[name], fit, validate, kf, kv, ext, alpha, min_gain, can_sim)

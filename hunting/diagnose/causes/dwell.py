@@ -329,7 +329,12 @@ def judge(fit, validate, kf, kv, model, can_sim, resolution):
     """The verdict on dwell (module docstring): a dict with statistic, p_value, parameters,
     sigma, metric, nominal, extended, model (the extended model) or reason (why not); with
     ``otherwise``, the verdict of the break-away level (:func:`level_verdict`) where every rest
-    shows one, judged when the growth test fails."""
+    shows one, judged when the growth test fails. On a LuGre model it is untestable: the bristles'
+    break-away is not a rest's (it depends on the loading rate), and the model cannot hold a growth
+    (:class:`hunting.diagnose.model.NominalModel`)."""
+    if model.law == "lugre":
+        return dict(reason="the model is LuGre: its contact never rests (the bristles' state carries it), so a "
+                           "break-away growth with the time at rest has nothing to act on in it", untestable=True)
     lf, lv = ((level_after_break_away(k, model) if k is not None and k.t.size == m.n else None)
               for k, m in ((kf, fit), (kv, validate)))
     t, F, s, scale = rests(fit, model, resolution, lf)

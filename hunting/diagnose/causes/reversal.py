@@ -75,6 +75,8 @@ def _sigma1(hyper, model) -> float:
 def untestable(kin, model) -> str | None:
     if model.law == "lugre":
         return "the nominal model has LuGre bristles already"
+    if model.dwell is not None:
+        return "the nominal model has a dwell growth, which LuGre bristles would replace (their contact never rests)"
     if min(model.curve.positive.Fc, model.curve.negative.Fc) <= 0:
         return "the nominal Coulomb level is zero: nothing builds up after reversals"
     if np.count_nonzero(np.diff(np.sign(kin.vf[np.abs(kin.vf) > 0])) != 0) < 2:
