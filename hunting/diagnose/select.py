@@ -553,14 +553,16 @@ def _confirmed_on_loop(rows: list, rejected: list, base: NominalModel, fit: Meas
                 "the loop)")
     cause = Cause(row["name"], v0 / max(v1, 1e-300) - 1, cut, None, pars,
                   {k: None for k in pars}, dict(metric=LOOP_METRIC, nominal=v0, extended=v1, evidence=evidence),
-                  dict(row["hyper"], evidence="loop"), np.asarray(row["theta"]),
+                  dict(row["hyper"], evidence="loop", fitted_on="force residual"), np.asarray(row["theta"]),
                   family=getattr(mod, "FAMILY", mod.NAME))
     return [r for r in rejected if r is not row], cause, ext
 
 
 def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinematics) -> dict:
-    """The force channel's result ``fc`` with the named causes that can be refined on the loop
-    (``refine_on_loop``: a resonance's load mass and damping) refitted on the fitting record's
+    """The force channel's result ``fc`` with the named causes whose coefficients the force
+    residual fitted (also those the loop confirmed at them, :func:`_loop_confirmation`) and that
+    can be refined on the loop (``refine_on_loop``: a resonance's load mass and damping, LuGre
+    bristles' stiffness and damping) refitted on the fitting record's
     re-simulated loop, kept where the validation record's re-simulated position error is no worse
     with the refined values (the refinement sees the fitting record only). A cause the fitting
     record (kinematics ``kf``) cannot show (``refinable`` says why: a resonance above its band,
@@ -575,14 +577,15 @@ def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinemat
     causes, model = list(fc["causes"]), fc["model"]
     for k, c in enumerate(causes):
         mod = CAUSES[c.name]
-        if not hasattr(mod, "refine_on_loop") or c.theta is None or c.hyper.get("evidence") == "loop":
+        on_loop = c.hyper.get("evidence") == "loop" and c.hyper.get("fitted_on") != "force residual"
+        if not hasattr(mod, "refine_on_loop") or c.theta is None or on_loop:
             continue
         if mod.refinable(kf, model, c.hyper) is not None:
             continue
         before = position_rms_error(validate, model)
         if not np.isfinite(before):
             continue
-        theta, hyper, sig = mod.refine_on_loop(fit, model, c.theta, c.hyper, c.sigma)
+        theta, hyper, sig = mod.refine_on_loop(fit, validate, model, c.theta, c.hyper, c.sigma)
         try:
             ext = mod.extend(model, theta, hyper)
         except SystemDefinitionError:

@@ -305,13 +305,14 @@ def refinable(kin, model, hyper) -> str | None:
     return None
 
 
-def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple[np.ndarray, dict, dict]:
+def refine_on_loop(fit, val, model, theta, hyper, sigma: dict | None = None) -> tuple[np.ndarray, dict, dict]:
     """The load mass and damping ratio of a named resonance refitted on the fitting record's
     re-simulated loop (whole-record position RMS error; ``model`` the extended model that holds
     the resonance at theta, hyper; the frequency kept): a LOOP_GRID x LOOP_GRID grid of log10 load
     mass and log10 damping within LOOP_SPAN of the force channel's values (the load mass below
     98 % of the whole mass), then LOOP_ROUNDS finer grids about its best point (at most 81 + 72
-    re-simulations).
+    re-simulations). ``val`` (the validation record) is not used: the force channel's value is
+    the second estimate of the uncertainty.
 
     The force residual sees the load through -m2 H(s) a, whose peak height is m2 / (2 zeta): the
     force fit trades the load mass against the damping, and its uncertainties did not cover the

@@ -369,6 +369,12 @@ def log_sigma0_sigma(fit, val, model, theta, segs, segs_val, hyper: dict | None 
     (blind development sets reporting46-49, the 51 true LuGre records named presliding: 39 of the
     sigma0 within 2 stated uncertainties at the chosen zeta, 40 jointly; reporting46 d0407, 5 %
     low, 2.6 -> 1.2 uncertainties off; reporting49 d0323, 62 % low, 15 -> 5.6)."""
+    return log_sigmas(fit, val, model, theta, segs, segs_val, hyper)[0]
+
+
+def log_sigmas(fit, val, model, theta, segs, segs_val, hyper: dict | None = None) -> tuple:
+    """(log10 sigma0's standard uncertainty, as :func:`log_sigma0_sigma`; log10 zeta's, the
+    sandwich estimate's where ``hyper`` holds a damping ratio, else None) [decades]."""
     hyper = hyper or {}
     lg = -float(np.log10(theta[0]))
     residual = None if segs is None else (lambda q_sim: creep_residual(q_sim, fit.q, segs))
@@ -377,14 +383,14 @@ def log_sigma0_sigma(fit, val, model, theta, segs, segs_val, hyper: dict | None 
     def model_at(v):
         return extend(model, np.array([10.0 ** -v[0]]), dict(hyper, zeta=10.0 ** v[1]) if v.size > 1 else hyper)
     sd = coefficients_sigma(fit, model_at, x, np.full(x.size, SIGMA_DECADES), residual=residual)
-    sig = None if sd is None else sd[0]
-    if sig is None:
-        return None
+    if sd is None or sd[0] is None:
+        return None, None if sd is None or x.size < 2 else sd[1]
     if segs is None:
         th_v = fit_behaviour(val, model, None, max_evals=LOOP_EVALS, step=LOOP_STEP, hyper=hyper)[0]
     else:
         th_v = fit_behaviour(val, model, segs_val, hyper=hyper)[0] if segs_val else None
-    return two_records(sig, lg, None if th_v is None else -float(np.log10(th_v[0])))
+    return (two_records(sd[0], lg, None if th_v is None else -float(np.log10(th_v[0]))),
+            sd[1] if x.size > 1 else None)
 
 
 def creep_residual(q_sim: np.ndarray, q: np.ndarray, segs) -> np.ndarray:

@@ -189,10 +189,6 @@ def unidentified(p, sig) -> str | None:
             "uncertainties of zero (no build-up)")
 
 
-# the loop refinement of a named reversal (:func:`refine_on_loop`)
-LOOP_STEP = 0.01    # [decades] the central difference of the refined values' uncertainty
-
-
 def refinable(kin, model, hyper) -> str | None:
     """Why the fitting record (kinematics ``kin``) cannot refine the bristles on its loop (None
     when it can): it turns fewer than twice (the build-up shows after reversals; a reversal
@@ -202,7 +198,7 @@ def refinable(kin, model, hyper) -> str | None:
     return None
 
 
-def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple[np.ndarray, dict, dict]:
+def refine_on_loop(fit, val, model, theta, hyper, sigma: dict | None = None) -> tuple[np.ndarray, dict, dict]:
     """sigma0 and the damping ratio zeta of a named reversal refitted together on the fitting
     record's re-simulated loop (``model`` the extended model that holds the bristles at ``hyper``;
     presliding's grid refinement, :func:`~hunting.diagnose.causes.presliding.refine_stiffness`,
@@ -215,27 +211,18 @@ def refine_on_loop(fit, model, theta, hyper, sigma: dict | None = None) -> tuple
     d0519 -40 %), and the truth's re-simulation followed the fitting record better than the
     reported values did (d0477: 2.4 against 3.6 um). Refined there: d0477 -3.6 %, d0595 +0.8 %,
     d0598 +0.8 %, d0519 +0.3 %. Returns (theta, hyper, sigma): theta (the force channel's
-    ``scale``) unchanged; hyper with the refined sigma0 and zeta; sigma {sigma0, zeta, sigma1}, the
-    larger of each value's within-record uncertainty on the loop (the two together,
-    :func:`~hunting.diagnose.loop_sigma.coefficients_sigma`) and its distance to the force
-    channel's value over sqrt(2) (:func:`~hunting.diagnose.loop_sigma.two_records`)."""
-    from ..loop_sigma import coefficients_sigma, two_records
+    ``scale``) unchanged; hyper with the refined sigma0 and zeta; sigma {sigma0, zeta, sigma1}:
+    the uncertainties of presliding's loop fit (:func:`~hunting.diagnose.causes.presliding.log_sigmas`:
+    the two together on the fitting record's loop, sigma0's at least half its distance to the
+    validation record's own loop fit), by the delta method in the values' units."""
     z0 = float(hyper.get("zeta", presliding.ZETA))
     th, hy, _ = presliding.refine_stiffness(fit, model, np.array([1.0 / hyper["sigma0"]]), {"zeta": z0},
                                             presliding.stiffest(model, fit) / 1.05)
-    s0, z = 1.0 / float(th[0]), float(hy["zeta"])
-    new = dict(hyper, sigma0=s0, zeta=z)
-
-    def at(x):
-        return extend(model, theta, dict(hyper, sigma0=10.0 ** x[0], zeta=10.0 ** x[1]))
-    x = np.log10([s0, z])
-    s_lg = coefficients_sigma(fit, at, x, np.full(2, LOOP_STEP)) or (None, None)
-    sig = {}
-    for key, value, start, s in (("sigma0", s0, hyper["sigma0"], s_lg[0]), ("zeta", z, z0, s_lg[1])):
-        s_tot = two_records(s, np.log10(value), np.log10(start))     # in decades, then by the delta method
-        sig[key] = None if s_tot is None else float(value * np.log(10.0) * s_tot)
-    p = parameters(theta, new, model)
-    sig.update(derived_sigma(p, sig))
+    new = dict(hyper, sigma0=1.0 / float(th[0]), zeta=float(hy["zeta"]))
+    s_lg, s_lz = presliding.log_sigmas(fit, val, model, th, None, None, hy)
+    sig = {key: None if s is None else float(new[key] * np.log(10.0) * s)
+           for key, s in (("sigma0", s_lg), ("zeta", s_lz))}
+    sig.update(derived_sigma(parameters(theta, new, model), sig))
     return np.asarray(theta), new, sig
 
 
