@@ -571,7 +571,8 @@ def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinemat
     fitting record with fewer than 512 sliding samples 21 % low). The cause's parameters,
     uncertainties and increments and the extended model then hold the refined values; its gain
     stays the force channel's evidence, and ``gain["refined_on_loop"]`` gives the validation
-    record's position RMS error at the force channel's values and at the refined ones [m]."""
+    record's position RMS error at the force channel's values and at the refined ones [m], and the
+    force channel's values (``force_channel_values``)."""
     from dataclasses import replace as replace_cause
     from .resimulate import position_rms_error
     causes, model = list(fc["causes"]), fc["model"]
@@ -596,7 +597,9 @@ def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinemat
         pars = mod.parameters(theta, hyper, model)
         inc = {n: pars[n] - (c.parameters[n] - d) for n, d in c.increments.items() if n in pars}
         sigma = {n: sig.get(n, c.sigma.get(n)) for n in pars}
-        gain = dict(c.gain, refined_on_loop=dict(metric=LOOP_METRIC, force_channel=before, refined=after))
+        gain = dict(c.gain, refined_on_loop=dict(metric=LOOP_METRIC, force_channel=before, refined=after,
+                                                 force_channel_values={n: c.parameters[n] for n in pars
+                                                                       if n in c.parameters}))
         causes[k] = replace_cause(c, parameters=pars, sigma=sigma, increments=inc, theta=np.asarray(theta),
                                   hyper=hyper, gain=gain)
         model = ext
