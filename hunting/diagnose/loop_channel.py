@@ -79,6 +79,16 @@ def spans(model: NominalModel, meas: Measurement) -> dict:
 GRIDS = {"stribeck": np.array([-0.95, -0.8, -0.65, -0.5, -0.4, -0.3, -0.2, -0.1, -0.05, 0.05, 0.1, 0.2, 0.3, 0.4,
                                0.5, 0.65, 0.8, 1.0, 1.5, 2.0, 3.0]),
          "stribeck vs": np.log(2.0) * np.arange(-6, 7) / 2.0}
+# the lag's grid where the force channel found it significant out of sample and only the loop can
+# confirm it (select._loop_admission): none, then 1 ms to 0.3 s in steps of 20 %. A loop that sticks
+# and slips has a valley about +-20 % wide at the true lag, and side valleys: reporting62 d0462, a
+# 24.8 ms lag, 91 % of both records' position error gone there, 41 % at 20 ms, 63 % at 30 ms and
+# 74 % (the fitting record; 44 % the validation record) in a side valley at 60 ms, which the linear
+# grid, 50 ms apart, found instead. Not where the loop judges a lag no sliding sample supports
+# (select._loop_force_channel, _small_on_loop): there the fine grid fitted clean records' stick-slip
+# phases (reporting62 d0018, d0105: 86 % and 59 % of the fitting record's error, 44 % and 46 % of
+# the validation record's, against 0 % on the linear grid)
+LAG_FINE_GRID = np.concatenate([[0.0], np.geomspace(1e-3, 0.3, 1 + int(round(np.log(300.0) / np.log(1.2))))])
 # candidates that are a second one-parameter form of a cause: the cause they name
 FORMS = {"stribeck vs": "stribeck"}
 
@@ -125,11 +135,12 @@ def extended(key: str, model: NominalModel, x: float) -> NominalModel | None:
         return None
 
 
-def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple) -> tuple[float, float]:
+def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple,
+            grid: np.ndarray | None = None) -> tuple[float, float]:
     """(x, error): candidate ``key``'s coefficient minimizing the re-simulated position RMS error [m]
     on ``meas``: a grid of GRID points over ``span`` (the candidate's own in :data:`GRIDS`), then
     bounded Brent within the best point's neighbours (at most REFINE more re-simulations); error
-    inf where no point re-simulates."""
+    inf where no point re-simulates. ``grid``: the coefficients tried first instead (within the span)."""
     from scipy.optimize import minimize_scalar
 
     from .resimulate import position_rms_error
@@ -142,7 +153,8 @@ def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple) -> tu
             e = position_rms_error(meas, ext) if ext is not None else np.inf
             cache[x] = e if np.isfinite(e) else np.inf
         return cache[x]
-    grid = GRIDS[key] if key in GRIDS else np.linspace(span[0], span[1], GRID)
+    if grid is None:
+        grid = GRIDS[key] if key in GRIDS else np.linspace(span[0], span[1], GRID)
     errs = [cost(g) for g in grid]
     k = int(np.argmin(errs))
     if not np.isfinite(errs[k]):
@@ -154,7 +166,7 @@ def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple) -> tu
     return best, cache[best]
 
 
-def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dict:
+def judge(fit: Measurement, val: Measurement, model: NominalModel, names, grids: dict | None = None) -> dict:
     """The loop channel's verdict on the force-channel causes ``names`` (those with a one-parameter
     loop extension, :func:`spans`): ``cause`` (name, candidate ``key``, coefficient ``x`` with its
     ``span`` and standard uncertainty ``sigma_x`` (:func:`~hunting.diagnose.loop_sigma.coefficient_sigma`,
@@ -163,8 +175,10 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
     fitting and validation position RMS errors nominal and extended) or None, ``alternatives``
     (the others that pass the bar, same fields), ``rejected`` (name, reason) for the candidates
     tried. A cause with two forms (:data:`FORMS`) is represented by the one that fits the fitting
-    record's loop better."""
+    record's loop better. ``grids``: {candidate key: coefficients} tried first instead of its
+    own grid (:func:`fit_one`), on both records' fits."""
     from .resimulate import position_rms_error
+    grids = grids or {}
     f0, v0 = position_rms_error(fit, model), position_rms_error(val, model)
     out = dict(cause=None, alternatives=[], rejected=[])
     if not (np.isfinite(f0) and f0 > 0 and np.isfinite(v0) and v0 > 0):
@@ -174,7 +188,7 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
     # the candidates' fits are independent and the re-simulation's kernel releases the GIL: on
     # threads they share the machine's cores (the same evaluations, in any order, give the same fits)
     with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), MAX_THREADS))) as pool:
-        fits = list(pool.map(lambda job: fit_one(job[0], fit, model, job[1]), jobs))
+        fits = list(pool.map(lambda job: fit_one(job[0], fit, model, job[1], grids.get(job[0])), jobs))
     best: dict = {}
     for (key, span), (x, f1) in zip(jobs, fits):
         name = cause_of(key)
@@ -199,7 +213,7 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names) -> dic
         r = tried[0]
         sig = loop_sigma.coefficient_sigma(fit, lambda x: extended(r["key"], model, x), r["x"],
                                            SIGMA_STEP * (r["span"][1] - r["span"][0]))
-        x_val = fit_one(r["key"], val, model, r["span"])[0] if sig is not None else None
+        x_val = fit_one(r["key"], val, model, r["span"], grids.get(r["key"]))[0] if sig is not None else None
         r["sigma_x"] = loop_sigma.two_records(sig, r["x"], x_val)
         out["cause"] = r
         out["alternatives"] = [r for r in tried[1:] if "reason" not in r]
