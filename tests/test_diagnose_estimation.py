@@ -1241,7 +1241,7 @@ def test_the_loop_channel_names_only_the_best_candidate_on_the_fitting_record(mo
                 else "level" if m.curve != model.curve else "other")
 
     def run(validation):
-        monkeypatch.setattr(loop_channel, "fit_one", lambda name, meas, m, span: (0.5, fitted[name]))
+        monkeypatch.setattr(loop_channel, "fit_one", lambda name, meas, m, span, grid=None: (0.5, fitted[name]))
         monkeypatch.setattr(resimulate, "position_rms_error",
                             lambda meas, m: 1.0 if changed(m) is None else validation[changed(m)])
         return loop_channel.judge(fit, val, model, list(fitted))
