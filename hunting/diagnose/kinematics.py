@@ -74,6 +74,12 @@ class Kinematics:
     def dt(self) -> float:
         return float(self.t[1] - self.t[0])
 
+    @property
+    def sensor_rms(self) -> float:
+        """The position sensor's own RMS error [m]: its quantization (resolution / sqrt(12)) and
+        its noise in quadrature."""
+        return float(np.hypot(self.resolution / np.sqrt(12.0), self.noise))
+
     def delayed_drive(self, delay: float) -> np.ndarray:
         """The drive [N] (n,) with its held part cm u delayed by ``delay`` [s] >= 0, as the second
         difference of the position sees it (:func:`seen_by_second_difference`; exact for any
@@ -288,8 +294,7 @@ def acceleration_noise_psd(kin: Kinematics, f: np.ndarray) -> np.ndarray:
     imp[w // 2] = 1.0
     h = savgol_filter(imp, w, 3, deriv=2, delta=dt, mode="constant")
     H = np.abs(np.exp(-2j * np.pi * np.outer(f, np.arange(w)) * dt) @ h)
-    var = kin.resolution ** 2 / 12 + kin.noise ** 2
-    return 2 * var * dt * H ** 2
+    return 2 * kin.sensor_rms ** 2 * dt * H ** 2
 
 
 def map_uncertain(kin: Kinematics, model, r: np.ndarray | None = None) -> np.ndarray:
@@ -307,7 +312,7 @@ def map_uncertain(kin: Kinematics, model, r: np.ndarray | None = None) -> np.nda
     imp = np.zeros(wf)
     imp[wf // 2] = 1.0
     g1 = float(np.sqrt(np.sum(savgol_filter(imp, wf, 3, deriv=1, delta=dt, mode="constant") ** 2)))
-    sigma_v = np.sqrt(kin.resolution ** 2 / 12 + kin.noise ** 2) * g1
+    sigma_v = kin.sensor_rms * g1
     pos, neg = model.curve.positive, model.curve.negative
     # the viscous part is linear: filtering it commutes with the map, its error does not grow
     slope = np.abs(np.where(kin.vf >= 0, pos.level_slope(kin.vf), neg.level_slope(kin.vf)))

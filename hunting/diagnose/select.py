@@ -576,7 +576,7 @@ def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinemat
     record's position RMS error at the force channel's values and at the refined ones [m], and the
     force channel's values (``force_channel_values``).
 
-    "No worse" is within the sensor's floor (:func:`_sensor_floor`): two re-simulations whose
+    "No worse" is within the sensor's floor (:attr:`Kinematics.sensor_rms` of ``kf``): two re-simulations whose
     errors differ by less than the position sensor's own RMS error follow the record equally well,
     and the loop's values, fitted where the loop shows the cause, are kept (reporting44 d0307: the
     refined load mass +5.6 % against the force channel's +20 %, the validation record's error 0.72
@@ -601,7 +601,7 @@ def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinemat
         except SystemDefinitionError:
             continue
         after = position_rms_error(validate, ext)
-        if not (np.isfinite(after) and after <= before + _sensor_floor(kf)):
+        if not (np.isfinite(after) and after <= before + kf.sensor_rms):
             continue
         pars = mod.parameters(theta, hyper, model)
         inc = {n: pars[n] - (c.parameters[n] - d) for n, d in c.increments.items() if n in pars}
@@ -613,12 +613,6 @@ def _loop_refined(fc: dict, fit: Measurement, validate: Measurement, kf: Kinemat
                                   hyper=hyper, gain=gain)
         model = ext
     return dict(fc, causes=causes, model=model)
-
-
-def _sensor_floor(kin: Kinematics) -> float:
-    """The position sensor's own RMS error [m] on a record (kinematics ``kin``): its quantization
-    (resolution / sqrt(12)) and its noise in quadrature."""
-    return float(np.hypot(kin.resolution / np.sqrt(12.0), kin.noise))
 
 
 def one_way_offset(result: list, untested: list, model: NominalModel, kin: Kinematics) -> list:
