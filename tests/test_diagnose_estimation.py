@@ -1599,21 +1599,28 @@ def test_resonance_load_mass_is_refined_on_the_loop():
     assert c.sigma["stiffness"] >= c.parameters["stiffness"] * relative * (1 - 1e-9)
 
 
-def test_grid_minimum_finds_an_analytic_minimum_within_its_bounds():
-    """loop_grid.grid_minimum on a quadratic bowl with minimum at (0.37, -0.12): after three
-    finer rounds the point is within a quarter of the first grid's step of it (the last grid's
-    spacing), every point is evaluated once (at most 9 x 7 + 3 x 24 calls), and a y_range that
-    excludes the minimum holds y at its edge."""
-    from hunting.diagnose.loop_grid import grid_minimum
-    calls = []
+def test_grid_minimum_finds_an_analytic_minimum_within_its_bounds(monkeypatch):
+    """loop_grid.grid_minimum on a quadratic bowl with minimum at (0.37, -0.12) (the 'model' at
+    (x, y) is the point, its 'error' the bowl): after three finer rounds the point is within a
+    quarter of the first grid's step of it (the last grid's spacing), every point is evaluated
+    once (at most 9 x 7 + 3 x 24 calls), and a y_range that excludes the minimum holds y at its
+    edge."""
+    import threading
 
-    def bowl(x, y):
-        calls.append((x, y))
+    from hunting.diagnose import resimulate
+    from hunting.diagnose.loop_grid import grid_minimum
+    calls, lock = [], threading.Lock()
+
+    def bowl(meas, point):
+        x, y = point
+        with lock:
+            calls.append((x, y))
         return (x - 0.37) ** 2 + 2.0 * (y + 0.12) ** 2
+    monkeypatch.setattr(resimulate, "position_rms_error", bowl)
     xs, ys = np.linspace(-1.0, 1.0, 9), np.linspace(-1.0, 1.0, 7)
-    c, x, y = grid_minimum(bowl, xs, ys, 3)
+    c, x, y = grid_minimum(None, lambda a, b: (a, b), xs, ys, 3)
     assert abs(x - 0.37) <= (xs[1] - xs[0]) / 4 and abs(y + 0.12) <= (ys[1] - ys[0]) / 4
     assert c == pytest.approx((x - 0.37) ** 2 + 2.0 * (y + 0.12) ** 2)
     assert len(calls) == len(set(calls)) <= 9 * 7 + 3 * 24
-    _, x2, y2 = grid_minimum(bowl, xs, ys, 3, (0.0, 1.0))
+    _, x2, y2 = grid_minimum(None, lambda a, b: (a, b), xs, ys, 3, (0.0, 1.0))
     assert y2 == 0.0 and abs(x2 - 0.37) <= (xs[1] - xs[0]) / 4

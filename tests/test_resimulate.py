@@ -406,3 +406,27 @@ def test_a_part_is_re_simulated_through_the_record_before_it():
     through = moved.from_record_start()
     assert np.array_equal(through.q_ref[:last.start], rec.q_ref[:last.start])
     assert np.array_equal(through.q_ref[last.start:], moved.q_ref)
+
+
+def test_re_simulations_side_by_side_equal_the_runs_one_after_the_other(monkeypatch):
+    """resimulate_many and position_rms_errors on four threads (the kernel releases the GIL):
+    for models that stick, slip and carry a dwell growth, the positions and errors are those of
+    the runs one after the other, bit for bit and in the models' order."""
+    from hunting.diagnose import resimulate as rs
+    from hunting.diagnose.model import Dwell
+    monkeypatch.setattr(rs, "THREADS", 4)
+    model = NominalModel.from_json("examples/pd_servo.json")
+    n, dt = 3000, 1e-3
+    t = np.arange(n) * dt
+    r = 0.004 * np.sin(2 * np.pi * 0.7 * t) * (t > 0.2)
+    meas = _meas(n, dt, r)
+    data = resimulate(meas, model.replace(offset=2.0))
+    meas = Measurement(meas.t, data.q, data.u, q_ref=r)
+    models = [model.replace(dwell=Dwell(0.0, g, 0.1)) for g in (0.0, 5.0, 20.0)] + [model.replace(mass=1.3 * model.mass),
+                                                                                    model.replace(offset=2.0)]
+    one_by_one = [resimulate(meas, m) for m in models]
+    together = rs.resimulate_many(meas, models)
+    assert all(np.array_equal(a.q, b.q) and np.array_equal(a.u, b.u) for a, b in zip(one_by_one, together))
+    errs = rs.position_rms_errors(meas, models)
+    assert errs == [rs.position_rms_error(meas, m) for m in models]
+    assert errs[-1] == 0.0 and len(set(errs)) == len(errs)        # the runs differ: the order is checked

@@ -25,13 +25,18 @@ def library_builder(fit: Measurement, validate: Measurement, kf: Kinematics, kv:
     estimation's error (said in ``notes`` unless None)."""
     from .force import Library
     from .method_error import method_error
+    from .resimulate import side_by_side
     step = max(1, int(round(kf.window / fit.dt)) // 3)
     sat = measured_saturation(fit, validate, model, alpha)
-    kr = reference_kinematics(validate, sat(model), window=window)
-    kfr = reference_kinematics(fit, sat(model), window=window) if kr is not None else None
+    # four independent re-simulations of the nominal loop, side by side: the instrument
+    # trajectories of both records and the estimation's error on each
+    kr, kfr, *errors = side_by_side(lambda job: job(), [
+        lambda: reference_kinematics(validate, sat(model), window=window),
+        lambda: reference_kinematics(fit, sat(model), window=window),
+        lambda: method_error(fit, kf, model), lambda: method_error(validate, kv, model)])
+    kfr, errors = (kfr if kr is not None else None), tuple(errors)
     inst = ((lambda m: reference_kinematics(validate, sat(m), window=window)) if kr is not None and model.controller is not None
             else None)
-    errors = (method_error(fit, kf, model), method_error(validate, kv, model))
     if notes is not None and any(e is not None for e in errors):
         notes.append(METHOD_NOTE.format(*(("not formed" if e is None else f"{e.rms:.3g} N RMS") for e in errors)))
     return lambda names: Library(names, kf, kv, model, kf.moving, kv.moving, step, kr, inst, errors, kfr)

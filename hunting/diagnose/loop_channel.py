@@ -23,9 +23,6 @@ records): the bar needs more clean records than the development sets had. The ev
 p-value: a stick-slip loop's position error is not a sum of independent terms."""
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 
 from ..errors import SystemDefinitionError
@@ -39,7 +36,6 @@ GRID = 7             # the grid of each candidate's parameter over its span
 REFINE = 5           # bounded Brent evaluations around the grid's best point
 MAX_DELAY = 0.02     # [s] the largest delay tried
 SIGMA_STEP = 0.01    # the central difference of the fitted coefficient's uncertainty: this share of its span
-MAX_THREADS = min(4, os.cpu_count() or 1)   # threads fitting the candidates side by side
 
 
 def spans(model: NominalModel, meas: Measurement) -> dict:
@@ -177,7 +173,7 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names, grids:
     tried. A cause with two forms (:data:`FORMS`) is represented by the one that fits the fitting
     record's loop better. ``grids``: {candidate key: coefficients} tried first instead of its
     own grid (:func:`fit_one`), on both records' fits."""
-    from .resimulate import position_rms_error
+    from .resimulate import position_rms_error, side_by_side
     grids = grids or {}
     f0, v0 = position_rms_error(fit, model), position_rms_error(val, model)
     out = dict(cause=None, alternatives=[], rejected=[])
@@ -187,8 +183,7 @@ def judge(fit: Measurement, val: Measurement, model: NominalModel, names, grids:
     jobs = [(key, span) for key, span in spans(model, fit).items() if cause_of(key) in names]
     # the candidates' fits are independent and the re-simulation's kernel releases the GIL: on
     # threads they share the machine's cores (the same evaluations, in any order, give the same fits)
-    with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), MAX_THREADS))) as pool:
-        fits = list(pool.map(lambda job: fit_one(job[0], fit, model, job[1], grids.get(job[0])), jobs))
+    fits = side_by_side(lambda job: fit_one(job[0], fit, model, job[1], grids.get(job[0])), jobs)
     best: dict = {}
     for (key, span), (x, f1) in zip(jobs, fits):
         name = cause_of(key)

@@ -66,26 +66,18 @@ def coefficients_sigma(meas: Measurement, model_at, x: np.ndarray, h: np.ndarray
     An entry is None where the residual does not depend on that coefficient, or the coefficient
     loads on a direction the record does not resolve (a singular value of J below RESOLVED of
     the largest); None where a re-simulation fails or no coefficient moves the residual."""
-    from .resimulate import resimulate
+    from .resimulate import resimulate_many
     x, h = np.asarray(x, float), np.asarray(h, float)
-
-    def res_at(xx):
-        m = model_at(xx)
-        sim = resimulate(meas, m) if m is not None else None
-        if sim is None or not sim.ok:
-            return None
-        return sim.q if residual is None else np.asarray(residual(sim.q), float)
-    centre = res_at(x)
-    if centre is None:
+    steps = np.diag(h)
+    points = [x] + [x + sign * steps[j] for j in range(x.size) for sign in (1.0, -1.0)]
+    models = [model_at(xx) for xx in points]
+    if any(m is None for m in models):
         return None
-    cols = []
-    for j in range(x.size):
-        step = np.zeros_like(x)
-        step[j] = h[j]
-        pair = [res_at(x + step), res_at(x - step)]
-        if any(v is None for v in pair):
-            return None
-        cols.append(pair)
+    sims = resimulate_many(meas, models)          # the centre and the central differences' pairs, side by side
+    if not all(sim.ok for sim in sims):
+        return None
+    res = [sim.q if residual is None else np.asarray(residual(sim.q), float) for sim in sims]
+    centre, cols = res[0], [res[1 + 2 * j:3 + 2 * j] for j in range(x.size)]
     n = min([centre.size] + [v.size for pair in cols for v in pair])
     if residual is None:
         r = centre[:n] - meas.q[:n]

@@ -31,6 +31,8 @@ The integral state starts where the first controller output equals the measured 
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 
 import numba
@@ -44,6 +46,7 @@ from .data import Measurement
 from .model import NominalModel
 
 _PID, _PDV = 1.0, 2.0
+THREADS = min(4, os.cpu_count() or 1)   # re-simulations run side by side (:func:`resimulate_many`)
 _CTRL_KEYS = {"pid": {"type", "form", "P", "D", "I", "K", "tau_d", "tau_i", "kp", "kd", "ki", "derivative_on",
                       "tau_f", "sample_time", "saturation", "output_resolution"},
               "pd-velocity-loop": {"type", "kp", "kv", "sample_time", "saturation", "output_resolution"}}
@@ -535,3 +538,27 @@ def position_rms_error(meas: Measurement, model: NominalModel) -> float:
     re-simulation failed): the validation metric of the behaviour-channel causes."""
     sim = resimulate(meas, model)
     return float(np.sqrt(np.mean((sim.q - meas.q[:sim.q.size]) ** 2))) if sim.ok else np.inf
+
+
+def side_by_side(run, items: list) -> list:
+    """[run(item) for item in items], on up to ``THREADS`` threads: for runs that re-simulate (the
+    kernel releases the GIL) and are independent, so that the results are those of the runs one
+    after the other, in the order of ``items``."""
+    items = list(items)
+    if len(items) < 2 or THREADS < 2:
+        return [run(item) for item in items]
+    with ThreadPoolExecutor(max_workers=min(len(items), THREADS)) as pool:
+        return list(pool.map(run, items))
+
+
+def resimulate_many(meas: Measurement, models: list) -> list:
+    """:func:`resimulate` of ``meas`` with each of ``models`` (default keywords), side by side
+    (:func:`side_by_side`)."""
+    return side_by_side(lambda m: resimulate(meas, m), models)
+
+
+def position_rms_errors(meas: Measurement, models: list) -> list:
+    """:func:`position_rms_error` [m] of each of ``models`` on ``meas``, side by side
+    (:func:`side_by_side`)."""
+    return side_by_side(lambda m: position_rms_error(meas, m), models)
+

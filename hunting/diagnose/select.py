@@ -332,9 +332,9 @@ def diagnose(fit: Measurement, model: NominalModel, validate: Measurement | None
     if behaviour and model.controller is not None and validate.q_ref is not None:
         tick("behaviour view")
         from .behaviour import compare
-        from .resimulate import resimulate, resolution_of
+        from .resimulate import resimulate_many, resolution_of
         res = model.resolution if model.resolution is not None else resolution_of(validate.q)
-        sims = {"nominal": resimulate(validate, model), "extended": resimulate(validate, ext)}
+        sims = dict(zip(("nominal", "extended"), resimulate_many(validate, [model, ext])))
         view = compare(validate, sims, model.cm, res)
         if result:
             notes += worse_resimulation(view)

@@ -113,33 +113,39 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
     their least-squares gain at each time of the grid is tried (:func:`reading_gain`)."""
     from scipy.optimize import minimize
 
-    from ..resimulate import position_rms_error
+    from ..loop_grid import cached_errors
     Fs = max(model.curve.positive.Fs, model.curve.negative.Fs)
     t = np.asarray(rest_times, float)
     if not (Fs > 0 and t.size and np.all(t > 0)):
         return model, np.inf
     cache = {}
 
-    def cost(x):                       # x = (log gain, log time)
-        key = (round(float(x[0]), 9), round(float(x[1]), 9))
-        if key not in cache:
-            e = position_rms_error(meas, _with(model, np.exp(x[0]), np.exp(x[1]), sliding))
-            cache[key] = e if np.isfinite(e) else np.inf
-        return cache[key]
+    def key(x):
+        return round(float(x[0]), 9), round(float(x[1]), 9)
+
+    def costs(xs):                     # xs: points (log gain, log time), re-simulated side by side
+        return cached_errors(meas, cache, xs, key, lambda a, b: _with(model, np.exp(a), np.exp(b), sliding))
+
+    def cost(x):
+        return costs([x])[0]
+
+    def best(xs):                      # the first of the points with the lowest cost
+        c = costs(xs)
+        return xs[int(np.argmin(c))]
     times = np.log(np.geomspace(0.5 * t.min(), 2.0 * t.max(), TIMES))
     points = [(np.log(g), lt) for g in Fs * np.geomspace(*GAIN_RANGE, GAINS) for lt in times] if grid else []
     if start is not None and start[0] > 0 and start[1] > 0:
         points.append((np.log(start[0]), np.log(start[1])))
     if not points:
         return model, np.inf
-    x0 = min(points, key=cost)
+    x0 = best(points)
     if grid and readings is not None and floor is not None and not cost(x0) < floor:
         # the grid's gains step by 3.2 times, and where every rest outlasts the growth the valley in
         # the gain is narrow: the readings' gains, tried only where the grid's best fails the screen
         # (where it passes, its path stands: from a reading's start Nelder-Mead ended elsewhere on
         # reporting28 d0366, its time 17 % short where it was 11 %)
         points += [(np.log(g), lt) for lt in times for g in [reading_gain(*readings, np.exp(lt))] if g > 0]
-        x0 = min(points, key=cost)
+        x0 = best(points)
     if np.isfinite(cost(x0)) and (floor is None or cost(x0) < floor):
         if line:
             # unprompted, from the grid alone: the loop's error falls into a valley in the gain
@@ -155,8 +161,8 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
             # from the grid's best time, 0.41 s, 54 % of the fitting record's error cut and 1 % of
             # the validation record's; from its shortest, 90 ms, 1.38 N over 80 ms cuts 72 and 68 %)
             steps = np.log(np.geomspace(*LINE_RANGE, LINE))
-            columns = [min((p for p in points if p[1] == lt), key=cost) for lt in times]
-            x0 = min([x0] + [(c[0] + d, c[1]) for c in columns for d in steps], key=cost)
+            columns = [best([p for p in points if p[1] == lt]) for lt in times]
+            x0 = best([x0] + [(c[0] + d, c[1]) for c in columns for d in steps])
         # from a start alone, a simplex of fixed steps in log gain and log time (scipy's default,
         # 5 % of |x0|, is tiny near log 1 = 0: a refit from the other record's values hardly moved)
         simplex = None if grid else np.array(x0) + np.array([[0.0, 0.0], [START_STEP, 0.0], [0.0, START_STEP]])

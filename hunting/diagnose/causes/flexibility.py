@@ -327,7 +327,6 @@ def refine_on_loop(fit, val, model, theta, hyper, sigma: dict | None = None) -> 
     and the force channel's frequency uncertainty (``sigma``, the cause's, with ``frequency``)."""
     from ..loop_grid import grid_minimum
     from ..loop_sigma import coefficients_sigma, two_records
-    from ..resimulate import position_rms_error
     m0, z0, f0 = float(theta[0]), float(hyper["damping"]), float(hyper["frequency"])
     top = 0.98 * model.mass
 
@@ -335,7 +334,7 @@ def refine_on_loop(fit, val, model, theta, hyper, sigma: dict | None = None) -> 
         return extend(model, np.array([min(m0 * 10.0 ** lm, top)]), dict(hyper, damping=z0 * 10.0 ** lz))
     lms = np.linspace(-LOOP_SPAN[0], min(LOOP_SPAN[0], np.log10(top / m0)), LOOP_GRID)
     lzs = np.linspace(-LOOP_SPAN[1], LOOP_SPAN[1], LOOP_GRID)
-    _, lm, lz = grid_minimum(lambda a, b: position_rms_error(fit, at(a, b)), lms, lzs, LOOP_ROUNDS)
+    _, lm, lz = grid_minimum(fit, at, lms, lzs, LOOP_ROUNDS)
     m, z = min(m0 * 10.0 ** lm, top), z0 * 10.0 ** lz
     # together: on the loop a heavier load and a more damped one trade (each read with the other
     # held left that out)

@@ -200,21 +200,24 @@ def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0,
     rejects every sigma0 above ``above`` needs no better one); hyper : the extension's
     hyper-parameters (the damping ratio ``zeta``; default ZETA). Returns (theta, the RMS error
     [m])."""
-    from ..resimulate import position_rms_error, resimulate
+    from ..resimulate import position_rms_errors, resimulate_many
     cache = {}
 
+    def costs(lgs):                    # log10 sigma0 values, re-simulated side by side
+        new = list(dict.fromkeys(lg for lg in lgs if lg not in cache))
+        exts = [extend(model, np.array([10.0 ** -lg]), hyper or {}) for lg in new]
+        if segs is None:
+            errs = position_rms_errors(meas, exts)
+        else:
+            errs = [creep_error(sim.q, meas.q, segs) if sim.ok else np.inf for sim in resimulate_many(meas, exts)]
+        cache.update(zip(new, errs))
+        return [cache[lg] for lg in lgs]
+
     def cost(lg):
-        if lg not in cache:
-            ext = extend(model, np.array([10.0 ** -lg]), hyper or {})
-            if segs is None:
-                cache[lg] = position_rms_error(meas, ext)
-            else:
-                sim = resimulate(meas, ext)
-                cache[lg] = creep_error(sim.q, meas.q, segs) if sim.ok else np.inf
-        return cache[lg]
+        return costs([lg])[0]
     top = max(np.log10(stiffest(model, meas)), 4.0)
     grid = np.linspace(3.0, top, max(3, int(round((top - 3.0) / step)) + 1))
-    k = int(np.argmin([cost(g) for g in grid]))
+    k = int(np.argmin(costs(list(grid))))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     if above is not None and a > np.log10(above):
         return np.array([10.0 ** -grid[k]]), cache[grid[k]]
@@ -343,15 +346,14 @@ def refine_stiffness(fit, model, theta, hyper: dict, top: float) -> tuple[np.nda
     (d0576, whose caller keeps the admitted fit). Returns (theta [1 / sigma0], hyper with
     ``zeta``, the fitting record's position RMS error [m] there)."""
     from ..loop_grid import grid_minimum
-    from ..resimulate import position_rms_error
 
-    def cost(lg, lz):
-        return position_rms_error(fit, extend(model, np.array([10.0 ** -lg]), dict(hyper, zeta=10.0 ** lz)))
+    def at(lg, lz):
+        return extend(model, np.array([10.0 ** -lg]), dict(hyper, zeta=10.0 ** lz))
     lg0 = -float(np.log10(theta[0]))
     hi = min(lg0 + REFINE_SPAN, float(np.log10(top)))
     lgs = np.linspace(min(lg0 - REFINE_SPAN, hi - 1e-6), hi, REFINE_GRID[0])
     lzs = np.linspace(np.log10(REFINE_ZETAS[0]), np.log10(REFINE_ZETAS[1]), REFINE_GRID[1])
-    err, lg, lz = grid_minimum(cost, lgs, lzs, REFINE_ROUNDS, (lzs[0], lzs[-1]))
+    err, lg, lz = grid_minimum(fit, at, lgs, lzs, REFINE_ROUNDS, (lzs[0], lzs[-1]))
     return np.array([10.0 ** -lg]), dict(hyper, zeta=float(10.0 ** lz)), float(err)
 
 
