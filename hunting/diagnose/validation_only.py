@@ -84,7 +84,8 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     # fitting record 91 % one way, read there as an offset, a level and a viscous change)
     nested = {n: [c for c in found if c in getattr(CAUSES[n], "NESTS", ()) and c not in chosen] for n in held}
     clash = {n: [c for c in found if not compatible([n, c]) and c not in nested[n]] for n in held}
-    inside = {n: why for n in held if nested[n] and n in partly and (why := seen(n, chosen[n].hyper, kf, ext))}
+    inside = {n: why for n in held if nested[n] and n in partly
+              and (why := seen(n, chosen[n].hyper, kf, ext, chosen[n].parameters))}
     replacing = [n for n in held if nested[n] and not clash[n] and n not in inside]
     held = [n for n in held if not clash[n] and not nested[n]]
     fc2 = dict(causes=[], model=ext, alternatives=[], explanations=[], rejected=[])
@@ -94,7 +95,8 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
                                         max_causes, alpha, min_gain, alpha_reference, [])
         # a cross cause found where the fitting record can show it after all (a resonance inside
         # its band) is what that record did not show
-        bad = {c.name: why for c in fc2["causes"] if c.name in partly and (why := seen(c.name, c.hyper, kf, ext))}
+        bad = {c.name: why for c in fc2["causes"]
+               if c.name in partly and (why := seen(c.name, c.hyper, kf, ext, c.parameters))}
         if not bad:
             break
         inside.update(bad)

@@ -90,11 +90,11 @@ def unseen(name: str, kf, kv, model) -> str | None:
     return _hook(name, "unseen", kf, kv, model)
 
 
-def seen(name: str, hyper: dict, kf, model) -> str | None:
-    """Why cause ``name`` at hyper-parameters ``hyper``, found where the fitting record (``kf``)
-    cannot show it all (:func:`unseen`), lies where that record can show it after all (its
-    ``seen`` hook), or None."""
-    return _hook(name, "seen", hyper, kf, model)
+def seen(name: str, hyper: dict, kf, model, parameters: dict | None = None) -> str | None:
+    """Why cause ``name`` at hyper-parameters ``hyper`` (its fitted ``parameters``), found where
+    the fitting record (``kf``) cannot show it all (:func:`unseen`), lies where that record can
+    show it after all (its ``seen`` hook, called with hyper, kf, model and parameters), or None."""
+    return _hook(name, "seen", hyper, kf, model, parameters or {})
 
 
 __all__ = ["CAUSES", "hyper_count", "hyper_keys", "seen", "unseen", "untestable"]

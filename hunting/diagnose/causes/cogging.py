@@ -185,7 +185,7 @@ def unseen(kf, kv, model) -> str | None:
             f"fewer than {MIN_PERIODS:g} periods of it; the validation record {_q(sv, None, 'm')})")
 
 
-def seen(hyper, kf, model) -> str | None:
+def seen(hyper, kf, model, parameters=None) -> str | None:
     """Why a pitch found on the validation record alone (:func:`unseen`) is one the fitting record
     could show, where it showed none: at most its stroke over MIN_PERIODS."""
     longest = stroke(kf) / MIN_PERIODS

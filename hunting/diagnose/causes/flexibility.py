@@ -218,7 +218,7 @@ def unseen(kf, kv, model) -> str | None:
             f"{s_f:.0%} of the fitting record's")
 
 
-def seen(hyper, kf, model) -> str | None:
+def seen(hyper, kf, model, parameters=None) -> str | None:
     """Why a resonance found on the validation record alone (:func:`unseen`) is the fitting
     record's to show after all, where that record showed none: its frequency at most the band's
     top and, there, a share of the fitting record's force residual of at least SEEN_SHARE."""

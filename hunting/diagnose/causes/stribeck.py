@@ -97,7 +97,7 @@ def unseen(kf, kv, model) -> str | None:
             f"the validation record up to {_q(sv, None, 'm/s')})")
 
 
-def seen(hyper, kf, model) -> str | None:
+def seen(hyper, kf, model, parameters=None) -> str | None:
     """Why a dip found on the validation record alone (:func:`unseen`) is one the fitting record
     could show, where it showed none: its velocity (the nominal's for the static level alone,
     ``dip``) at most the fitting record's top speed."""
