@@ -124,13 +124,18 @@ def test_validation_noise_model_survives_a_cancelled_library_fit():
     0.6 ms delay too small to matter. The whole library fitted on the fitting data predicted the
     validation data worse than nothing, and a noise model of that residual made the offset's test
     p = 0.2: nothing was reported. Without the library's unphysical members the noise model is the
-    noise's and the offset is found, within 1 % of the truth."""
+    noise's and the offset is found, within 1 % of the truth. Since the forty-eighth session the
+    delay is searched on the validation record's blocks too (its drive force changes more than 3
+    times faster than the one-way fitting record's: delay.unseen) and found, 0.65 ms for a true
+    0.60, and the offset's value is the blocks' joint fit with it, within 2 %."""
     fit, val, model, truth = _dataset("tuning", 207)
     assert truth["causes"] == ["offset", "delay"]
     d = diagnose(fit, model, val, behaviour=False)
-    assert [c.name for c in d.causes][:1] == ["offset"], [(c.name, c.parameters) for c in d.causes]
-    true = truth["effects"][0]["params"]["offset"]
-    assert abs(d.causes[0].parameters["offset"] - true) < 0.01 * abs(true)
+    got = {c.name: c.parameters for c in d.causes}
+    assert set(got) == {"offset", "delay"}, got
+    true = {e["cause"]: e["params"] for e in truth["effects"]}
+    assert got["offset"]["offset"] == pytest.approx(true["offset"]["offset"], rel=0.02)
+    assert got["delay"]["delay"] == pytest.approx(true["delay"]["delay"], rel=0.1)
 
 
 def _found(d, name):
@@ -783,7 +788,7 @@ def test_a_resonance_the_fitting_record_could_show_is_not_named_from_the_validat
     found (``seen`` says so): that record showed none there, so the resonance is rejected with
     that reason (in its one row) and nothing is named."""
     from hunting.diagnose.causes import flexibility
-    monkeypatch.setattr(flexibility, "seen", lambda hyper, kf, model: "inside the fitting record's band (test)")
+    monkeypatch.setattr(flexibility, "seen", lambda hyper, kf, model, parameters: "inside the fitting record's band (test)")
     fit, val, model, _ = _dataset("reporting34", 349)
     d = diagnose(fit, model, val, behaviour=False)
     assert d.causes == [], [(c.name, c.parameters) for c in d.causes]
@@ -850,7 +855,7 @@ def test_a_pitch_the_fitting_stroke_shows_is_not_named_from_the_validation_recor
     assert cogging.stroke(kin) == pytest.approx(3e-3)
     assert cogging.seen({"pitch": 1.9e-3}, kin, None) is not None
     assert cogging.seen({"pitch": 2.1e-3}, kin, None) is None
-    monkeypatch.setattr(cogging, "seen", lambda hyper, kf, model: "a pitch the fitting stroke shows (test)")
+    monkeypatch.setattr(cogging, "seen", lambda hyper, kf, model, parameters: "a pitch the fitting stroke shows (test)")
     fit, val, model, _ = _dataset("reporting36", 588)
     d = diagnose(fit, model, val, behaviour=False)
     assert [c.name for c in d.causes] == ["offset"], [(c.name, c.parameters) for c in d.causes]
