@@ -430,3 +430,18 @@ def test_re_simulations_side_by_side_equal_the_runs_one_after_the_other(monkeypa
     errs = rs.position_rms_errors(meas, models)
     assert errs == [rs.position_rms_error(meas, m) for m in models]
     assert errs[-1] == 0.0 and len(set(errs)) == len(errs)        # the runs differ: the order is checked
+
+
+def test_the_re_simulation_threads_come_from_hunting_threads(monkeypatch):
+    """HUNTING_THREADS sets the threads (1 where processes fill the cores); a value that is not a
+    positive integer warns, naming it, and the machine's default stands."""
+    from hunting.diagnose.resimulate import _threads
+    monkeypatch.setenv("HUNTING_THREADS", "3")
+    assert _threads() == 3
+    monkeypatch.delenv("HUNTING_THREADS")
+    default = _threads()
+    assert 1 <= default <= 4
+    for bad in ("0", "-2", "two"):
+        monkeypatch.setenv("HUNTING_THREADS", bad)
+        with pytest.warns(UserWarning, match=f"HUNTING_THREADS = '{bad}'"):
+            assert _threads() == default

@@ -96,6 +96,8 @@ def _one(args) -> tuple[str, float]:
 
 
 def _nice():
+    # the pool's processes fill the cores: no re-simulation threads inside each
+    os.environ.setdefault("HUNTING_THREADS", "1")
     try:
         os.nice(10)
     except OSError:

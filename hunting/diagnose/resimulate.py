@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 
@@ -46,7 +47,28 @@ from .data import Measurement
 from .model import NominalModel
 
 _PID, _PDV = 1.0, 2.0
-THREADS = min(4, os.cpu_count() or 1)   # re-simulations run side by side (:func:`resimulate_many`)
+
+
+def _threads() -> int:
+    """The threads re-simulations run on side by side (:func:`side_by_side`): the environment's
+    HUNTING_THREADS (a positive integer; set 1 where processes already fill the cores, as the test
+    suite's workers do), else min(4, the machine's cores)."""
+    default = min(4, os.cpu_count() or 1)
+    raw = os.environ.get("HUNTING_THREADS")
+    if raw is None:
+        return default
+    try:
+        n = int(raw)
+    except ValueError:
+        n = 0
+    if n < 1:
+        warnings.warn(f"HUNTING_THREADS = {raw!r} is not a positive integer: re-simulating on {default} threads")
+        return default
+    return n
+
+
+THREADS = _threads()
+
 _CTRL_KEYS = {"pid": {"type", "form", "P", "D", "I", "K", "tau_d", "tau_i", "kp", "kd", "ki", "derivative_on",
                       "tau_f", "sample_time", "saturation", "output_resolution"},
               "pd-velocity-loop": {"type", "kp", "kv", "sample_time", "saturation", "output_resolution"}}
