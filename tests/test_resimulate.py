@@ -445,3 +445,22 @@ def test_the_re_simulation_threads_come_from_hunting_threads(monkeypatch):
         monkeypatch.setenv("HUNTING_THREADS", bad)
         with pytest.warns(UserWarning, match=f"HUNTING_THREADS = '{bad}'"):
             assert _threads() == default
+
+
+def test_side_by_side_inside_its_own_threads_runs_in_them(monkeypatch):
+    """A side_by_side called from one of side_by_side's threads (the loop channel's candidates,
+    each with its grid) runs its items in that thread, one after the other: no pool inside a
+    pool; called from outside, the items spread over the threads."""
+    import threading
+
+    from hunting.diagnose import resimulate as rs
+    monkeypatch.setattr(rs, "THREADS", 4)
+    barrier = threading.Barrier(2, timeout=10)
+
+    def outer(_):
+        barrier.wait()              # both outer items run at once: on two threads
+        me = threading.get_ident()
+        return me, rs.side_by_side(lambda _: threading.get_ident(), range(3))
+    got = rs.side_by_side(outer, range(2))
+    assert got[0][0] != got[1][0]
+    assert all(inner == [me] * 3 for me, inner in got)

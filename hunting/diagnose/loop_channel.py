@@ -139,19 +139,17 @@ def fit_one(key: str, meas: Measurement, model: NominalModel, span: tuple,
     inf where no point re-simulates. ``grid``: the coefficients tried first instead (within the span)."""
     from scipy.optimize import minimize_scalar
 
-    from .resimulate import position_rms_error
+    from .loop_grid import cached_errors
     cache = {}
 
+    def costs(xs):                     # the coefficients, re-simulated side by side
+        return cached_errors(meas, cache, [float(x) for x in xs], lambda x: x, lambda x: extended(key, model, x))
+
     def cost(x):
-        x = float(x)
-        if x not in cache:
-            ext = extended(key, model, x)
-            e = position_rms_error(meas, ext) if ext is not None else np.inf
-            cache[x] = e if np.isfinite(e) else np.inf
-        return cache[x]
+        return costs([x])[0]
     if grid is None:
         grid = GRIDS[key] if key in GRIDS else np.linspace(span[0], span[1], GRID)
-    errs = [cost(g) for g in grid]
+    errs = costs(grid)
     k = int(np.argmin(errs))
     if not np.isfinite(errs[k]):
         return float(grid[k]), np.inf

@@ -23,7 +23,8 @@ def grid_minimum(meas, model_at, xs: np.ndarray, ys: np.ndarray, rounds: int,
     cache = {}
 
     def at(points):
-        errs = cached_errors(meas, cache, points, lambda p: (round(float(p[0]), 9), round(float(p[1]), 9)), model_at)
+        errs = cached_errors(meas, cache, points, lambda p: (round(float(p[0]), 9), round(float(p[1]), 9)),
+                             lambda p: model_at(*p))
         return [(e, float(x), float(y)) for e, (x, y) in zip(errs, points)]
     best = min(at([(a, b) for a in xs for b in ys]))
     dx, dy = xs[1] - xs[0], ys[1] - ys[0]
@@ -37,17 +38,19 @@ def grid_minimum(meas, model_at, xs: np.ndarray, ys: np.ndarray, rounds: int,
     return best
 
 
-def cached_errors(meas, cache: dict, points: list, key, model_at) -> list:
-    """Re-simulated position RMS errors [m] on ``meas`` of ``model_at(*point)`` for each of
-    ``points`` (inf where a re-simulation fails), each ``key(point)`` evaluated once, at its first
-    point (``cache``: {key: error}, updated), the new ones side by side
-    (:func:`~hunting.diagnose.resimulate.position_rms_errors`)."""
+def cached_errors(meas, cache: dict, points: list, key, model_at, errors=None) -> list:
+    """Errors [m] on ``meas`` of ``model_at(point)`` for each of ``points`` (inf where the model is
+    None or a re-simulation fails), each ``key(point)`` evaluated once, at its first point
+    (``cache``: {key: error}, updated), the new ones side by side: ``errors(meas, models)`` (default
+    the re-simulated position RMS errors, :func:`~hunting.diagnose.resimulate.position_rms_errors`)."""
     from .resimulate import position_rms_errors
     new = {}
     for p in points:
         k = key(p)
         if k not in cache and k not in new:
             new[k] = p
-    errs = position_rms_errors(meas, [model_at(*p) for p in new.values()])
-    cache.update((k, float(e) if np.isfinite(e) else np.inf) for k, e in zip(new, errs))
+    models = {k: model_at(p) for k, p in new.items()}
+    run = [k for k, m in models.items() if m is not None]
+    errs = dict(zip(run, (errors or position_rms_errors)(meas, [models[k] for k in run])))
+    cache.update((k, float(e) if np.isfinite(e := errs.get(k, np.inf)) else np.inf) for k in new)
     return [cache[key(p)] for p in points]

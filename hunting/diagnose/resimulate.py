@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
@@ -68,6 +69,7 @@ def _threads() -> int:
 
 
 THREADS = _threads()
+_POOL_THREAD = threading.local()   # marks side_by_side's own threads (no pool inside a pool)
 
 _CTRL_KEYS = {"pid": {"type", "form", "P", "D", "I", "K", "tau_d", "tau_i", "kp", "kd", "ki", "derivative_on",
                       "tau_f", "sample_time", "saturation", "output_resolution"},
@@ -567,10 +569,14 @@ def side_by_side(run, items: list) -> list:
     kernel releases the GIL) and are independent, so that the results are those of the runs one
     after the other, in the order of ``items``."""
     items = list(items)
-    if len(items) < 2 or THREADS < 2:
-        return [run(item) for item in items]
+    if len(items) < 2 or THREADS < 2 or getattr(_POOL_THREAD, "busy", False):
+        return [run(item) for item in items]   # (inside a pool's thread the machine's cores are taken)
+
+    def in_pool(item):
+        _POOL_THREAD.busy = True
+        return run(item)
     with ThreadPoolExecutor(max_workers=min(len(items), THREADS)) as pool:
-        return list(pool.map(run, items))
+        return list(pool.map(in_pool, items))
 
 
 def resimulate_many(meas: Measurement, models: list) -> list:

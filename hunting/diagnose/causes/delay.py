@@ -23,9 +23,10 @@ UNITS = {"delay": "s"}
 # validation record's to show (:func:`unseen`; stribeck's, cogging's and flexibility's factor)
 UNSEEN_FACTOR = 3.0
 # the share of the fitting record's residual RMS a delay's force there must reach for that record
-# to show it (:func:`seen`): explained, a force s times the residual's RMS removes 1 - 1/sqrt(1 +
-# s^2) of it, 29 % at s = 1: a delay that large no search of that record misses. At the rule's
-# min_gain (5 %, s = 0.33) a delay beside a cause of its signature's family was lost (reporting62
+# to show it (:func:`seen`): a record whose residual holds a force of RMS f has a residual of RMS
+# at least f wherever the rest is uncorrelated with it, so a delay whose force exceeds the whole
+# residual is not in that record. At the rule's min_gain share (0.33: explained, it removes 5 %
+# of the residual's RMS) a delay beside a cause of its signature's family was lost (reporting62
 # d0569: 0.24 ms beside a Stribeck change, its force on the fitting record 0.64 times that
 # record's residual, read there as a viscous change)
 SEEN_SHARE = 1.0

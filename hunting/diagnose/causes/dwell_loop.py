@@ -124,7 +124,7 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
         return round(float(x[0]), 9), round(float(x[1]), 9)
 
     def costs(xs):                     # xs: points (log gain, log time), re-simulated side by side
-        return cached_errors(meas, cache, xs, key, lambda a, b: _with(model, np.exp(a), np.exp(b), sliding))
+        return cached_errors(meas, cache, xs, key, lambda x: _with(model, np.exp(x[0]), np.exp(x[1]), sliding))
 
     def cost(x):
         return costs([x])[0]

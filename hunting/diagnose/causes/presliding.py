@@ -200,18 +200,17 @@ def fit_behaviour(meas, model, segs, *, max_evals: int = 14, step: float = 1.0,
     rejects every sigma0 above ``above`` needs no better one); hyper : the extension's
     hyper-parameters (the damping ratio ``zeta``; default ZETA). Returns (theta, the RMS error
     [m])."""
-    from ..resimulate import position_rms_errors, resimulate_many
+    from ..loop_grid import cached_errors
+    from ..resimulate import resimulate_many
     cache = {}
 
+    def creep_errors(m, exts):
+        return [creep_error(sim.q, m.q, segs) if sim.ok else np.inf for sim in resimulate_many(m, exts)]
+
     def costs(lgs):                    # log10 sigma0 values, re-simulated side by side
-        new = list(dict.fromkeys(lg for lg in lgs if lg not in cache))
-        exts = [extend(model, np.array([10.0 ** -lg]), hyper or {}) for lg in new]
-        if segs is None:
-            errs = position_rms_errors(meas, exts)
-        else:
-            errs = [creep_error(sim.q, meas.q, segs) if sim.ok else np.inf for sim in resimulate_many(meas, exts)]
-        cache.update(zip(new, errs))
-        return [cache[lg] for lg in lgs]
+        return cached_errors(meas, cache, lgs, lambda lg: lg,
+                             lambda lg: extend(model, np.array([10.0 ** -lg]), hyper or {}),
+                             None if segs is None else creep_errors)
 
     def cost(lg):
         return costs([lg])[0]
