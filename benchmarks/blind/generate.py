@@ -67,7 +67,8 @@ FAMILIES = {"tuning": 1, "reporting": 2, "test": 3, "tuning-level": 4, "reportin
             "reporting60": 64,
             "reporting61": 65,
             "reporting62": 66,
-            "reporting63": 67}
+            "reporting63": 67,
+            "reporting64": 68}
 # (clean, single effect, two effects)
 SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0), "tuning-level": (0, 24, 0),
          "reporting2": (120, 224, 112), "reporting3": (120, 224, 112),
@@ -102,7 +103,8 @@ SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10,
          "reporting60": (300, 224, 112),
          "reporting61": (300, 224, 112),
          "reporting62": (300, 224, 112),
-         "reporting63": (300, 224, 112)}
+         "reporting63": (300, 224, 112),
+         "reporting64": (300, 224, 112)}
 # the causes each family draws its effects from (the families drawn before ``level`` existed keep
 # their list: their datasets are a function of it)
 FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.CAUSES, "tuning-level": ("level",),
@@ -138,7 +140,8 @@ FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.C
                  "reporting60": draw.ALL_CAUSES,
                  "reporting61": draw.ALL_CAUSES,
                  "reporting62": draw.ALL_CAUSES,
-                 "reporting63": draw.ALL_CAUSES}
+                 "reporting63": draw.ALL_CAUSES,
+                 "reporting64": draw.ALL_CAUSES}
 # the tests' subset: short records, the strong half of the size range, ten causes
 SHORT = ("test",)
 TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
