@@ -396,6 +396,13 @@ def _loop_cause(r: dict, model: NominalModel, evidence: str, statistic, p_value)
 
 
 LOOP_METRIC = "re-simulated position RMS error [m], validation"
+# a cause that failed only the out-of-sample significance is confirmed by the loop at its fitted
+# values where the validation record's position error falls by LOOP_GAIN and the fitting record's
+# does not grow (:func:`_loop_confirmation`): that record fixed the values and may barely excite
+# the cause (reporting62 d0307, a 24.7 Hz load: 10 % fitting, 85 % validation, p = 0.004; over the
+# 116 loop judgements of reporting62-63's stored results no other row passed the validation bar
+# but a true reversal, 42 % and 78 %, and clean records' reached 23 % at most)
+CONFIRMATION_FITTING_BAR = 0.0
 
 
 def _blocks_then_loop(fc: dict, fit: Measurement, validate: Measurement, model: NominalModel, names) -> dict:
@@ -462,9 +469,12 @@ def _loop_confirmation(fc: dict, fit: Measurement, validate: Measurement) -> dic
     takes the ringing for noise (reporting44 d0419: a 13.9 Hz load at damping 0.025, the validation
     force residual 25 % smaller with it and p = 0.32; re-simulated with it the loop's position
     error fell by 98 % on the validation record). No coefficient is fitted on the loop, so both
-    records are out of sample for this evidence."""
+    records are out of sample for this evidence. The fitting record, whose force residual fixed
+    the coefficients, may barely excite the cause: its position error need only not grow
+    (CONFIRMATION_FITTING_BAR)."""
     rows = [r for r in fc["rejected"] if r.get("significance_only") and "theta" in r]
-    found = _confirmed_on_loop(rows, fc["rejected"], fc["model"], fit, validate, "on the force residual")
+    found = _confirmed_on_loop(rows, fc["rejected"], fc["model"], fit, validate, "on the force residual",
+                               fitting_bar=CONFIRMATION_FITTING_BAR)
     if found is None:
         return fc
     rejected, cause, ext = found
@@ -512,22 +522,28 @@ def _small_on_loop(rows: list, rejected: list, base: NominalModel, fit: Measurem
 
 
 def _confirmed_on_loop(rows: list, rejected: list, base: NominalModel, fit: Measurement, validate: Measurement,
-                       where: str) -> tuple | None:
+                       where: str, fitting_bar: float | None = None) -> tuple | None:
     """(rejected, cause or None, extended model or None), or None where nothing was judged: the
     rejected force-channel ``rows`` (with their fitted ``theta`` and ``hyper``) judged on the loop
     at those coefficients: ``base`` with the cause added, re-simulated, must cut the position RMS
     error of both records by at least LOOP_GAIN against ``base`` (the largest cut is taken, one
-    cause). ``rejected``, the whole list of rows, comes back with what the loop found in each
-    judged row's reason, the named one's row removed; ``where`` says where the row's reason was
-    found, in the named cause's evidence."""
+    cause), or, with ``fitting_bar``, the validation record's by LOOP_GAIN and the fitting record's
+    by at least ``fitting_bar`` (the validation record's cut is then the one ranked). ``rejected``,
+    the whole list of rows, comes back with what the loop found in each judged row's reason, the
+    named one's row removed; ``where`` says where the row's reason was found, in the named cause's
+    evidence."""
     from .causes.presliding import LOOP_GAIN
     from .resimulate import position_rms_error
     if not rows:
         return None
+
+    def needed(relaxed: bool) -> str:
+        return (f"{LOOP_GAIN:.0%} validation, the fitting record's at least {fitting_bar:.0%}" if relaxed
+                else f"{LOOP_GAIN:.0%} on both")
     f0, v0 = position_rms_error(fit, base), position_rms_error(validate, base)
     if not (np.isfinite(f0) and np.isfinite(v0) and f0 > 0 and v0 > 0):
         return None
-    best, cuts = None, {}
+    best, cuts, relaxed_rows = None, {}, set()
     for row in rows:
         mod = CAUSES[row["name"]]
         try:
@@ -535,24 +551,33 @@ def _confirmed_on_loop(rows: list, rejected: list, base: NominalModel, fit: Meas
         except SystemDefinitionError:
             continue
         f1, v1 = position_rms_error(fit, ext), position_rms_error(validate, ext)
-        cuts[id(row)] = (relative_fall(f0, f1), relative_fall(v0, v1))
-        cut = min(cuts[id(row)])
-        if np.isfinite(cut) and cut >= LOOP_GAIN and (best is None or cut > best[0]):
+        cf, cv = cuts[id(row)] = (relative_fall(f0, f1), relative_fall(v0, v1))
+        # LuGre bristles keep both bars: the stick channel fits them on the loop where the force
+        # channel does not name them (reporting62 d0519: confirmed here at 42 % and 78 %, sigma0
+        # 23 % off after the loop's refinement; the stick channel's, named without it, 6 %)
+        relaxed = fitting_bar is not None and not (ext.law == "lugre" and base.law != "lugre")
+        if relaxed:
+            relaxed_rows.add(id(row))
+        cut = cv if relaxed else min(cf, cv)
+        if np.isfinite(cut) and cv >= LOOP_GAIN and cf >= (fitting_bar if relaxed else LOOP_GAIN) and (
+                best is None or cut > best[0]):
             best = (cut, row, ext, (f0, f1), (v0, v1))
     # what the loop found, in the reason of each cause it did not admit
     rejected = [r if id(r) not in cuts or (best is not None and r is best[1]) else dict(
         r, reason=(f"{r['reason']}; and on the loop at its fitted values it cuts the position error by "
-                   f"{cuts[id(r)][0]:.1%} fitting and {cuts[id(r)][1]:.1%} validation ({LOOP_GAIN:.0%} on both "
-                   "needed)")) for r in rejected]
+                   f"{cuts[id(r)][0]:.1%} fitting and {cuts[id(r)][1]:.1%} validation "
+                   f"({needed(id(r) in relaxed_rows)} needed)")) for r in rejected]
     if best is None:
         return rejected, None, None
     cut, row, ext, (f0, f1), (v0, v1) = best
     mod = CAUSES[row["name"]]
     pars = mod.parameters(row["theta"], row["hyper"], base)
+    followed = ("the validation record better, the fitting record no worse" if id(row) in relaxed_rows
+                else "both records better")
     evidence = (f"{row['reason']} {where}; the loop re-simulated with it at the force channel's fitted "
-                f"values follows both records better: position RMS error -{relative_fall(f0, f1):.0%} fitting, "
-                f"-{relative_fall(v0, v1):.0%} validation (at least {LOOP_GAIN:.0%} on both needed; nothing fitted on "
-                "the loop)")
+                f"values follows {followed}: position RMS error -{relative_fall(f0, f1):.0%} fitting, "
+                f"-{relative_fall(v0, v1):.0%} validation (at least {needed(id(row) in relaxed_rows)} needed; nothing "
+                "fitted on the loop)")
     cause = Cause(row["name"], v0 / max(v1, 1e-300) - 1, cut, None, pars,
                   {k: None for k in pars}, dict(metric=LOOP_METRIC, nominal=v0, extended=v1, evidence=evidence),
                   dict(row["hyper"], evidence="loop", fitted_on="force residual"), np.asarray(row["theta"]),
