@@ -732,6 +732,21 @@ def test_a_band_within_the_estimates_spread_is_no_reason_for_a_search_but_the_mo
     assert why is not None and why.startswith("a resonance the fitting record's motion does not excite: at 34."), why
 
 
+def test_the_blocks_choose_again_without_a_cause_the_fitting_record_could_show():
+    """reporting64 d0495 (Fc and Fs 28 % low on a Coulomb-viscous model; a fitting record 92 % one
+    way, which cannot show a level): on the validation record's blocks the first choice held a
+    Stribeck dip whose velocity, 2.5 mm/s, lies in the fitting record's speeds (``seen``), and the
+    level, which alone cut the blocks' residual by 94 %, lost to it and was never judged alone:
+    nothing was named. Chosen again without the dip, the level is named, Fc within 0.1 %."""
+    fit, val, model, truth = _dataset("reporting64", 495)
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["level"], ([(c.name, c.parameters) for c in d.causes], d.rejected)
+    true = truth["effects"][0]["params"]
+    assert d.causes[0].parameters["Fc"] == pytest.approx(true["Fc"], rel=1e-3)
+    row = next(r for r in d.rejected if r["name"] == "stribeck")
+    assert "lies in the fitting record's speeds" in row["reason"], row
+
+
 def test_a_cause_the_fitting_records_loop_barely_shows_is_confirmed_by_the_validation_records():
     """reporting62 d0307 (a 24.7 Hz load of 0.76 kg, damping 0.027): fitted on the force residual
     (24.4 Hz, 0.70 kg, damping 0.040) it fails only the out-of-sample significance (p = 0.004). On
