@@ -67,14 +67,18 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     # again without it (reporting64 d0495, a level 28 % low on a one-way fitting record: the
     # blocks chose a Stribeck dip whose velocity lies in the fitting record's speeds, and the
     # level, which alone cut the blocks' residual by 94 %, was never judged on its own)
+    def seen_in(result: dict) -> dict:
+        """{cause: why} of the result's causes the fitting record could show after all (``seen``)."""
+        return {c.name: why for c in result["causes"]
+                if c.name in partly and (why := seen(c.name, c.hyper, kf, ext, c.parameters))}
+
     inside: dict = {}
     candidates = list(cross) + found + mates
     for _ in range(len(cross) + 1):          # each pass removes at least one candidate or ends the loop
         inner: list = []
         judged = identified_force_channel(library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None),
                                            candidates, model, max_causes, alpha, min_gain, alpha_reference, inner)
-        seen_here = {c.name: why for c in judged["causes"]
-                     if c.name in partly and (why := seen(c.name, c.hyper, kf, ext, c.parameters))}
+        seen_here = seen_in(judged)
         if not seen_here:
             break
         inside.update(seen_here)
@@ -108,8 +112,7 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
                                         max_causes, alpha, min_gain, alpha_reference, [])
         # a cross cause found where the fitting record can show it after all (a resonance inside
         # its band) is what that record did not show
-        bad = {c.name: why for c in fc2["causes"]
-               if c.name in partly and (why := seen(c.name, c.hyper, kf, ext, c.parameters))}
+        bad = seen_in(fc2)
         if not bad:
             break
         inside.update(bad)
