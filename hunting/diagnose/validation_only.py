@@ -74,10 +74,11 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
 
     inside: dict = {}
     candidates = list(cross) + found + mates
+    blocks_library = library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None)   # its nominal runs once
     for _ in range(len(cross) + 1):          # each pass removes at least one candidate or ends the loop
         inner: list = []
-        judged = identified_force_channel(library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None),
-                                           candidates, model, max_causes, alpha, min_gain, alpha_reference, inner)
+        judged = identified_force_channel(blocks_library, candidates, model, max_causes, alpha, min_gain,
+                                           alpha_reference, inner)
         seen_here = seen_in(judged)
         if not seen_here:
             break
