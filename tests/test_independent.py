@@ -133,6 +133,27 @@ def test_dwell_in_the_seven_parameter_form_is_named_from_the_loop(tmp_path):
     assert dg.extended_model.dwell.sliding is True
 
 
+def test_a_resonance_of_a_record_that_barely_slides_is_named_from_the_loop(tmp_path):
+    """Seed 10 d0086 (held out in the forty-ninth session, looked at in the fiftieth): a 19.5 Hz
+    load carrying 26 % of the mass (damping ratio 0.029) on records with fewer than 100 sliding
+    samples: the force channel is skipped, and no one-parameter loop candidate passes. The load
+    fitted on the fitting record's loop is named, its frequency within 2 % and its load mass
+    within 10 % of the truth."""
+    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(tmp_path), "--seed", "10",
+                    "--only", "86"], check=True, capture_output=True)
+    dd = tmp_path / "d0086"
+    truth = json.loads((dd / "truth.json").read_text())
+    assert truth["causes"] == ["flexibility"]
+    dg = diagnose(load(dd / "fit.npz"), NominalModel.from_json(dd / "model.json"), load(dd / "val.npz"))
+    assert [c.name for c in dg.causes] == ["flexibility"]
+    p, s = dg.causes[0].parameters, dg.causes[0].sigma
+    assert p["frequency"] == pytest.approx(truth["params"]["f_res"], rel=0.02)
+    assert p["load_mass"] == pytest.approx(truth["params"]["m2"], rel=0.1)
+    assert dg.extended_model.flexibility.load_mass == pytest.approx(p["load_mass"], rel=1e-12)
+    assert all(s[k] is None or s[k] > 0 for k in ("frequency", "load_mass", "damping", "stiffness"))
+    assert "force channel skipped" in " ".join(dg.notes)
+
+
 def test_reversal_identification_judges_the_refined_scale():
     """reversal.unidentified on its own: a scale outside SCALE_RANGE or within MIN_SCALE_Z
     uncertainties of zero is not LuGre's build-up; a scale near 1 far from zero is."""

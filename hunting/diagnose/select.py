@@ -377,7 +377,32 @@ def _loop_force_channel(fit: Measurement, validate: Measurement, model: NominalM
     out["causes"] = [] if r is None else [_loop_cause(r, model, loop_channel.evidence_text(r), r["gain_fit"], None)]
     if r is not None:
         out["model"] = loop_channel.extended(r["key"], model, r["x"])
+    elif "flexibility" in names:
+        out = _loop_resonance(out, fit, validate, model, why, untested)
     return out
+
+
+def _loop_resonance(out: dict, fit: Measurement, validate: Measurement, model: NominalModel, why: str,
+                    untested: list) -> dict:
+    """The force channel's part of the result where it was skipped for ``why`` and no one-parameter
+    loop candidate was named (``out``, :func:`_loop_force_channel`'s): a resonance searched on the
+    loop (:func:`hunting.diagnose.loop_resonance.judge`), named where it passes, else its reason
+    with the rejected; flexibility no longer untested either way."""
+    from . import loop_resonance
+    r = loop_resonance.judge(fit, validate, model)
+    untested[:] = [u for u in untested if u["name"] != "flexibility"]
+    if not r["significant"]:
+        row = dict(name="flexibility", step="loop", statistic=None, p_value=None, validation_gain=None,
+                   reason=f"{why}; and {r['reason']}")
+        return dict(out, rejected=out.get("rejected", []) + [row])
+    p = r["parameters"]
+    before, after = r["val"]
+    cause = Cause("flexibility", before / max(after, 1e-300) - 1, r["gain_fit"], None, p, r["sigma"],
+                  dict(metric=LOOP_METRIC, nominal=before, extended=after, evidence=loop_resonance.evidence_text(r, why)),
+                  {"frequency": p["frequency"], "damping": p["damping"], "evidence": "loop"},
+                  np.array([p["load_mass"]]), {"load_mass": p["load_mass"], "stiffness": p["stiffness"]},
+                  CAUSES["flexibility"].FAMILY)
+    return dict(out, causes=[cause], model=r["model"])
 
 
 def _loop_cause(r: dict, model: NominalModel, evidence: str, statistic, p_value) -> Cause:

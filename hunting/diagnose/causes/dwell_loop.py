@@ -120,7 +120,8 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
     ``start``: (gain [N], time [s]) tried beside the grid (the break-away readings' fit);
     ``floor`` [m]: where the grid's best error is not below it, the grid's best is returned (no
     Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone; ``sliding``: the growth's form
-    (:class:`~hunting.diagnose.model.Dwell`; None: the model's own, Kato's where it has none);
+    (:class:`~hunting.diagnose.model.Dwell`; None: the model's own, and where it has none each
+    form it can hold, :func:`forms`, the one with the smaller error taken);
     ``line``: a fine line in the gain (LINE points over LINE_RANGE times the grid's best gain at
     that time) at every time of the grid, and the best of their points, before Nelder-Mead;
     ``readings``: (t_k (k,) [s], e_k (k,) [N]), break-aways read on ``meas`` (rest times and
