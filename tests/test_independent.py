@@ -29,6 +29,13 @@ def records(tmp_path_factory):
     return out
 
 
+def _one(tmp_path, seed: int, index: int) -> Path:
+    """The directory of record ``index`` of the generator's set ``seed``, drawn alone under tmp_path."""
+    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(tmp_path), "--seed",
+                    str(seed), "--only", str(index)], check=True, capture_output=True)
+    return tmp_path / f"d{index:04d}"
+
+
 def _diagnosis(records, i):
     dd = records / f"d{i:04d}"
     truth = json.loads((dd / "truth.json").read_text())
@@ -104,9 +111,7 @@ def test_a_build_up_outside_lugres_range_at_the_refined_bristles_is_not_named(tm
     tests' noise model from the fitting record where the validation residual's innovations are
     more than 4 times its own) already out of sample (p = 0.49); no bristles are named for a
     resonance. The identification step itself: test_reversal_identification_judges_the_refined_scale."""
-    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(tmp_path), "--seed", "8",
-                    "--only", "41"], check=True, capture_output=True)
-    dd = tmp_path / "d0041"
+    dd = _one(tmp_path, 8, 41)
     assert json.loads((dd / "truth.json").read_text())["causes"] == ["flexibility"]
     dg = diagnose(load(dd / "fit.npz"), NominalModel.from_json(dd / "model.json"), load(dd / "val.npz"))
     assert "reversal" not in [c.name for c in dg.causes], [(c.name, c.parameters, c.sigma) for c in dg.causes]
@@ -122,9 +127,7 @@ def test_dwell_in_the_seven_parameter_form_is_named_from_the_loop(tmp_path):
     and Kato's form, the only one the loop fitted before, cut the fitting record's position error
     by 0.8 %: nothing was named. Fitted in both forms, the seven-parameter one is taken and named,
     its gain within 10 % of the truth."""
-    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(tmp_path), "--seed", "10",
-                    "--only", "51"], check=True, capture_output=True)
-    dd = tmp_path / "d0051"
+    dd = _one(tmp_path, 10, 51)
     truth = json.loads((dd / "truth.json").read_text())
     assert truth["causes"] == ["dwell"]
     dg = diagnose(load(dd / "fit.npz"), NominalModel.from_json(dd / "model.json"), load(dd / "val.npz"))
@@ -139,9 +142,7 @@ def test_a_resonance_of_a_record_that_barely_slides_is_named_from_the_loop(tmp_p
     samples: the force channel is skipped, and no one-parameter loop candidate passes. The load
     fitted on the fitting record's loop is named, its frequency within 2 % and its load mass
     within 10 % of the truth."""
-    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "independent" / "generate.py"), str(tmp_path), "--seed", "10",
-                    "--only", "86"], check=True, capture_output=True)
-    dd = tmp_path / "d0086"
+    dd = _one(tmp_path, 10, 86)
     truth = json.loads((dd / "truth.json").read_text())
     assert truth["causes"] == ["flexibility"]
     dg = diagnose(load(dd / "fit.npz"), NominalModel.from_json(dd / "model.json"), load(dd / "val.npz"))
