@@ -65,14 +65,14 @@ def test_a_model_with_a_load_already_is_not_searched_again():
 
 
 def test_the_validation_records_own_fit_must_find_the_same_load():
-    """Two fits of one load agree (frequency within 5 %, load mass and damping within a factor
-    1.5); reporting63 d0277's two records' fits (128.6 Hz, 0.134 kg against 142.8 Hz, 0.367 kg)
-    and a damping four times apart do not, and the words say which."""
+    """Two fits of one load agree (frequency within 5 %, load mass within a factor 1.5; the
+    damping ratio, which one record fixes least, may differ: seed-11 d0081's 0.030 and 0.083);
+    reporting63 d0277's two records' fits (128.6 Hz, 0.134 kg against 142.8 Hz, 0.367 kg) do not,
+    and the words say which."""
     m = NominalModel.from_dict(MODEL)
     x = loop_resonance._coefficients(128.6, 0.134 / m.mass, 0.09)
     assert loop_resonance._disagreement(m, x, loop_resonance._coefficients(131.0, 0.15 / m.mass, 0.1)) is None
     far = loop_resonance._disagreement(m, x, loop_resonance._coefficients(142.8, 0.367 / m.mass, 0.093))
     assert "143 Hz against 129 Hz" in far and "load mass 0.367 kg against 0.134 kg" in far and "damping" not in far
-    assert "damping 0.36 against 0.09" in loop_resonance._disagreement(
-        m, x, loop_resonance._coefficients(128.6, 0.134 / m.mass, 0.36))
+    assert loop_resonance._disagreement(m, x, loop_resonance._coefficients(128.6, 0.134 / m.mass, 0.36)) is None
     assert "does not re-simulate" in loop_resonance._disagreement(m, x, None)

@@ -136,13 +136,16 @@ def test_dwell_in_the_seven_parameter_form_is_named_from_the_loop(tmp_path):
     assert dg.extended_model.dwell.sliding is True
 
 
-def test_a_resonance_of_a_record_that_barely_slides_is_named_from_the_loop(tmp_path):
+@pytest.mark.parametrize("seed, index", [(10, 86), (11, 81)])
+def test_a_resonance_of_a_record_that_barely_slides_is_named_from_the_loop(tmp_path, seed, index):
     """Seed 10 d0086 (held out in the forty-ninth session, looked at in the fiftieth): a 19.5 Hz
     load carrying 26 % of the mass (damping ratio 0.029) on records with fewer than 100 sliding
     samples: the force channel is skipped, and no one-parameter loop candidate passes. The load
     fitted on the fitting record's loop is named, its frequency within 2 % and its load mass
-    within 10 % of the truth."""
-    dd = _one(tmp_path, 10, 86)
+    within 10 % of the truth. Seed 11 d0081 (held out in the fiftieth until the loop's resonance
+    met it: 18.4 Hz, 51 % of the mass): the validation record's own fit agreed in frequency and
+    load mass and not in damping (0.083 against 0.030), which is no longer asked."""
+    dd = _one(tmp_path, seed, index)
     truth = json.loads((dd / "truth.json").read_text())
     assert truth["causes"] == ["flexibility"]
     dg = diagnose(load(dd / "fit.npz"), NominalModel.from_json(dd / "model.json"), load(dd / "val.npz"))

@@ -10,8 +10,8 @@ Nyquist frequency) times load shares of the whole mass (SHARES) at damping ratio
 Nelder-Mead on log frequency, the share's logit and log damping (at most REFINE evaluations). It
 is named when it cuts both records' position RMS error by at least
 :data:`~hunting.diagnose.causes.presliding.LOOP_GAIN`, the loop channel's bar, and the validation
-record's own fit (the same search on that record) finds the same load (AGREE_FREQUENCY,
-AGREE_FACTOR); both records' fits give its uncertainties
+record's own fit (the same search on that record) finds the same load (its frequency and load
+mass: AGREE_FREQUENCY, AGREE_FACTOR); both records' fits give its uncertainties
 (:func:`~hunting.diagnose.loop_sigma.two_records`).
 
 Three coefficients fitted on one record's loop fit much of any stick-slip error there, and the
@@ -22,9 +22,9 @@ d0105), and on two the validation record's too: reporting63 d0277 (128.6 Hz, 11 
 73 and 64 %) and d0216 (7.3 Hz: 86 and 46 %); of the 53 effect records of those sets whose force
 channel was skipped, reporting63 d0423 (a saturation, 5.6 Hz: 77 and 73 %). No bar on the gains
 separates them from a true load (seed-10 d0086: 97 and 83 %) with any room. The validation
-record's own fit does: it finds d0086's load again within 0.4 % in frequency, 0.9 % in load mass
-and 8 % in damping, and puts the others' 8-13 % away in frequency with 2.7 times the load mass
-(d0277, d0216) or 4 times the damping (d0423). It runs apart from the one-parameter candidates
+record's own fit does: it finds d0086's load again within 0.4 % in frequency and 0.9 % in load
+mass, and puts the others' 8-13 % away in frequency, d0277's and d0216's with 2.7 times the load
+mass. It runs apart from the one-parameter candidates
 (:func:`hunting.diagnose.loop_channel.judge`), after them, so a fit this flexible never stands
 before one of theirs on the fitting record. The independent generator's seed-10 d0086 (a 19.5 Hz
 load, 26 % of the mass, damping 0.029, fewer than 100 sliding samples): 19.6 Hz, 26 %, 0.030."""
@@ -48,10 +48,13 @@ DAMPING_RANGE = (0.002, 1.0)    # the damping ratios the refinement may reach
 REFINE = 40                     # Nelder-Mead evaluations after the grid
 SIGMA_STEP = 0.01               # half step of the coefficients' central differences
 # the validation record's own fit (its own grid) must find the same load: its frequency within
-# AGREE_FREQUENCY (relative) and its load mass and damping ratio within a factor AGREE_FACTOR of
-# the fitting record's. Set on the development records (module docstring): the true d0086 0.4 %,
-# 0.9 % and 8 %; the clean reporting63 d0277 and d0216 11 and 13 % in frequency, 2.7 times in
-# load mass; reporting63 d0423's extra (a saturated loop) 8.4 % and 4 times in damping
+# AGREE_FREQUENCY (relative) and its load mass within a factor AGREE_FACTOR of the fitting
+# record's. Set on the development records (module docstring): the true d0086 0.4 % and 0.9 %; the
+# clean reporting63 d0277 and d0216 11 and 13 % in frequency, 2.7 times in load mass; reporting63
+# d0423's extra (a saturated loop) 8.4 % in frequency. Not the damping ratio, which the ringing's
+# decay on one record fixes least: the independent seed-11 d0081 (an 18.4 Hz load, damping 0.029,
+# held out until then) was fitted at 18.4 Hz and 0.030 on the fitting record, cut both errors by
+# 79 %, and its validation record's own fit found the same frequency and load mass at damping 0.083
 AGREE_FREQUENCY = 0.05
 AGREE_FACTOR = 1.5
 
@@ -164,10 +167,9 @@ def _disagreement(model: NominalModel, x: np.ndarray, x_val: np.ndarray | None) 
     words = []
     if abs(b["frequency"] / a["frequency"] - 1.0) > AGREE_FREQUENCY:
         words.append(f"{b['frequency']:.3g} Hz against {a['frequency']:.3g} Hz ({AGREE_FREQUENCY:.0%} allowed)")
-    for key, unit in (("load_mass", " kg"), ("damping", "")):
-        if max(a[key], b[key]) > AGREE_FACTOR * min(a[key], b[key]):
-            words.append(f"{key.replace('_', ' ')} {b[key]:.3g}{unit} against {a[key]:.3g}{unit} "
-                         f"(a factor {AGREE_FACTOR:g} allowed)")
+    if max(a["load_mass"], b["load_mass"]) > AGREE_FACTOR * min(a["load_mass"], b["load_mass"]):
+        words.append(f"load mass {b['load_mass']:.3g} kg against {a['load_mass']:.3g} kg "
+                     f"(a factor {AGREE_FACTOR:g} allowed)")
     return None if not words else "the validation record's own fit finds " + ", ".join(words)
 
 
