@@ -133,7 +133,9 @@ def judge(fit_meas: Measurement, val_meas: Measurement, model: NominalModel) -> 
         return dict(out, reason="the nominal loop does not re-simulate these records")
     x, f1 = fit(fit_meas, model)
     if x is None:
-        return dict(out, reason=f"the fitting record's sampling leaves no frequency above {F_MIN:g} Hz to try")
+        why = ("no load re-simulates the fitting record" if frequencies(fit_meas).size else
+               f"the fitting record's sampling leaves no frequency above {F_MIN:g} Hz to try")
+        return dict(out, reason=why)
     gain_fit = 1.0 - f1 / f0
     out.update(x=x, fit=(f0, f1), gain_fit=gain_fit)
     p = parameters(model, x)
