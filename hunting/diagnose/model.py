@@ -207,8 +207,7 @@ class NominalModel:
                 "friction dwell applies to the static laws: with law 'lugre' the contact never rests (the bristles' "
                 "state carries it), so a break-away growth with the time at rest has nothing to act on; give a static "
                 "law (coulomb-viscous, stribeck or switch) with dwell, or LuGre without it")
-        if self.dwell is not None and self.dwell.sliding and not all(
-                c.Fs > c.Fc and not c.discontinuous for c in (self.curve.positive, self.curve.negative)):
+        if self.dwell is not None and self.dwell.sliding and not self.has_stribeck_shape():
             raise SystemDefinitionError(
                 "friction dwell sliding = true needs a Stribeck curve in both directions (Fs > Fc, a finite beta): "
                 "the slip after a rest starts from the grown break-away force and decays along it; with law "
@@ -296,6 +295,11 @@ class NominalModel:
         of the smaller Stribeck velocity (0 for curves without a Stribeck dip)."""
         pos, neg = self.curve.positive, self.curve.negative
         return 0.1 * min(pos.vs, neg.vs) if (pos.Fs > pos.Fc or neg.Fs > neg.Fc) else 0.0
+
+    def has_stribeck_shape(self) -> bool:
+        """Whether both directions' curves have a continuous Stribeck dip (Fs > Fc, a finite beta):
+        the shape a seven-parameter dwell growth decays along (:class:`Dwell` ``sliding``)."""
+        return all(c.Fs > c.Fc and not c.discontinuous for c in (self.curve.positive, self.curve.negative))
 
     def steady_slide(self, v) -> np.ndarray:
         """bool (n,): where the static curve's slope d F / d|v| (Stribeck level and viscous term,

@@ -100,10 +100,9 @@ def _with(model, gain: float, time: float, sliding: bool | None = None):
 
 def forms(model) -> tuple:
     """The growth's forms (Dwell.sliding) ``model`` can hold: both where its curve has a Stribeck
-    dip in both directions (the seven-parameter slip decays along it), Kato's alone elsewhere."""
-    c = model.curve
-    dip = all(b.Fs > b.Fc and not b.discontinuous for b in (c.positive, c.negative))
-    return FORMS if dip and model.law != "lugre" else FORMS[:1]
+    dip in both directions (the seven-parameter slip decays along it,
+    :meth:`~hunting.diagnose.model.NominalModel.has_stribeck_shape`), Kato's alone elsewhere."""
+    return FORMS if model.has_stribeck_shape() else FORMS[:1]
 
 
 def form_words(dwell) -> str:
