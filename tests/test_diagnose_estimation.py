@@ -29,7 +29,8 @@ def _used_kinematics(fit, val, model):
     from dataclasses import replace
     from hunting.diagnose.select import default_window
     w = default_window(fit, val, model)
-    sensor = dict(resolution=model.resolution, noise=model.sensor_noise, steady=model.steady_slide)
+    from hunting.diagnose.parts import sensor_settings
+    sensor = sensor_settings(model)
     return tuple(replace(k, moving=used_samples(k, model)) for k in (kinematics(m, model.cm, window=w, **sensor)
                                                                      for m in (fit, val)))
 
@@ -472,8 +473,8 @@ def test_a_resonance_above_the_loop_bandwidth_is_found():
     from hunting.diagnose.select import default_window
     fit, val, model, truth = _dataset("reporting22", 321)
     true = truth["effects"][0]["params"]
-    kin = kinematics(fit, model.cm, window=default_window(fit, val, model), resolution=model.resolution,
-                     noise=model.sensor_noise, steady=model.steady_slide)
+    from hunting.diagnose.parts import sensor_settings
+    kin = kinematics(fit, model.cm, window=default_window(fit, val, model), **sensor_settings(model))
     kin = dc_replace(kin, moving=used_samples(kin, model))
     near = [h for h in flexibility.hypers(kin, model) if abs(np.log(h["frequency"] / true["frequency"])) < np.log(1.2)
             and abs(np.log(h["damping"] / true["damping"])) < np.log(2.0)]
@@ -890,7 +891,6 @@ def test_a_pitch_longer_than_the_fitting_stroke_is_searched_on_the_validation_re
     pitches the fitting stroke cannot show are searched on the validation record's alternate
     blocks and judged on the others: both are named, each value within 2 %; and a pitch the
     fitting stroke could show (``seen``) is not named from the validation record."""
-    from hunting.diagnose.causes import cogging
     fit, val, model, truth = _dataset("reporting36", 588)
     d = diagnose(fit, model, val, behaviour=False)
     assert sorted(c.name for c in d.causes) == ["cogging", "offset"], ([(c.name, c.parameters) for c in d.causes],
@@ -1569,7 +1569,7 @@ def test_a_growth_the_rests_suggest_is_named_on_a_smaller_validation_cut():
     assert [c.name for c in d.causes] == ["dwell"], [(c.name, c.parameters) for c in d.causes]
     c = d.causes[0]
     assert c.parameters["gain"] == pytest.approx(truth["effects"][0]["params"]["gain"], rel=0.1)
-    assert f"p = " in c.gain["evidence"] and f"< {GATE:g}" in c.gain["evidence"]
+    assert "p = " in c.gain["evidence"] and f"< {GATE:g}" in c.gain["evidence"]
     assert d.extended_model.dwell.gain == pytest.approx(c.parameters["gain"], rel=1e-9)
 
 

@@ -144,3 +144,76 @@ def test_the_acceleration_filter_is_scipys_savitzky_golay_second_derivative(shap
     t = np.arange(shape[0]) * dt
     assert np.allclose(acceleration_filter(np.full(shape[0], 2.0), dt, w), 2.0)
     assert np.allclose(savgol_filter(t ** 2, w, 3, deriv=2, delta=dt, mode="interp"), 2.0)
+
+
+def _pid_loop_edge(mass, cm, kp, kd, ki, tau_f, T):
+    """The spectral radius, as a function of the friction curve's slope c [N s/m], of the loop
+    python-control closes: plant cm / (m s^2 + c s) held over T, the digital PID of the
+    diagnosis's controller (integral kp + ki T z / (z - 1), derivative kd (z - 1) / ((tau_f + T)
+    z - tau_f)), unit negative feedback."""
+    import control as ct
+    z = ct.tf([1, 0], [1], T)
+    C = kp + ki * T * z / (z - 1) + kd * (z - 1) / ((tau_f + T) * z - tau_f)
+    return lambda c: float(np.max(np.abs(ct.poles(ct.feedback(ct.c2d(ct.tf([cm], [mass, c, 0]), T, "zoh") * C, 1)))))
+
+
+@pytest.mark.parametrize("kp, kd, ki, tau_f, T", [(317319.9, 3279.3, 15771479.8, 0.0, 1 / 4026.6),
+                                                  (2605.0, 105.4, 9632.0, 0.0, 1e-3),
+                                                  (4599.0, 171.9, 25411.8, 0.00124, 5e-4)])
+def test_the_steady_slope_is_the_sampled_loops_stability_edge(kp, kd, ki, tau_f, T):
+    """The slope a steady slide tolerates is STEADY_SHARE of the edge where the sampled loop
+    about the slide loses stability: python-control's closed loop (a second construction of the
+    same digital PID and zero-order-held plant) has its largest pole inside the unit circle 1 %
+    on the safe side of the edge and outside 1 % beyond it, and the edge approaches the
+    continuous loop's Routh-Hurwitz bound c = m ki / kp - kd cm at fast sampling."""
+    from hunting.diagnose import NominalModel
+    from hunting.diagnose.loop import STEADY_SHARE, steady_slope
+    mass, cm = 15.0, 1.33
+    model = NominalModel.from_dict({"plant": {"mass": mass, "motor_constant": cm},
+                                    "friction": {"law": "stribeck", "Fc": 1.0, "Fs": 1.5, "vs": 0.003, "b": 0.0},
+                                    "controller": {"type": "pid", "kp": kp, "kd": kd, "ki": ki, "tau_f": tau_f}})
+    edge = steady_slope(model, T) / STEADY_SHARE
+    rho = _pid_loop_edge(mass, cm, kp, kd, ki, tau_f, T)
+    assert edge < 0
+    assert rho(0.99 * edge) < 1.0 < rho(1.01 * edge)
+    if tau_f == 0.0:
+        assert edge == pytest.approx(mass * ki / kp - kd * cm, rel=0.02)
+    free = NominalModel.from_dict({"plant": {"mass": mass}, "friction": {"law": "stribeck", "Fc": 1.0, "Fs": 1.5,
+                                                                         "vs": 0.003, "b": 0.0}})
+    assert steady_slope(free, T) == 0.0
+
+
+def test_a_stiff_loop_holds_a_slow_slide_on_the_falling_branch():
+    """Independent seed 11 d0050's case: a ramp at 0.09 counts per sample (a count every 11
+    samples) inside a Stribeck dip, under a PID whose damping outweighs the curve's negative
+    slope many times. The free mass's rule calls the whole slide a stick; the slow-slide reading
+    (the loop's rule, the long span that sees counts this sparse), a slide; a 20-sample pause
+    amid the ramp stays a stick under both."""
+    from hunting.diagnose import NominalModel
+    from hunting.diagnose.parts import slow_slide_settings
+    res, dt, n = 1e-6, 2.5e-4, 4000
+    t = np.arange(n) * dt
+    rate = 0.09 * res / dt                                            # 0.36 mm/s
+    x = np.clip(t - 0.1, 0.0, None) * rate
+    x = np.where(t > 0.6, x - np.clip(t - 0.6, 0.0, 20 * dt) * rate, x)    # a pause of 20 samples at 0.6 s
+    q = _quantized(x + 0.3 * res, res)
+    friction = {"law": "stribeck", "Fc": 1.0, "Fs": 1.5, "vs": 0.0005, "beta": 2.0, "b": 0.0}
+    stiff = NominalModel.from_dict({"plant": {"mass": 15.0, "motor_constant": 1.33}, "friction": friction,
+                                    "controller": {"type": "pid", "kp": 3.2e5, "kd": 3.3e3, "ki": 1.6e7}})
+    meas = Measurement(t, q, np.zeros(n))
+    free = kinematics(meas, 1.0, window=0.0108, resolution=res, steady=stiff.steady_slide)
+    held = kinematics(meas, 1.0, window=0.0108, **dict(slow_slide_settings(stiff, dt), resolution=res))
+    v = np.abs(held.v)
+    inside = (t > 0.15) & (t < 0.9) & (np.abs(t - 0.6025) > 0.01)
+    assert (stiff.curve.positive.level_slope(v[inside]) < -100).all()          # the falling branch
+    assert free.slide[inside].mean() < 0.05
+    assert held.slide[inside].mean() > 0.99
+    pause = (t > 0.6 + 3 * dt) & (t < 0.6 + 17 * dt)
+    assert not held.slide[pause].any() and not free.slide[pause].any()
+    # the map's velocity has the slide's direction: the short window's cubic derivative of a
+    # staircase this sparse has the other sign on a fifth of the samples, the long window's not
+    from scipy.signal import savgol_filter
+    short = savgol_filter(q, max(5, (int(round(0.0108 / dt)) | 1) // 3 | 1), 3, deriv=1, delta=dt)
+    assert (short[inside] <= 0).mean() > 0.1
+    assert (held.vf[inside & held.slide] > 0).all()
+    assert held.slow_slides and not free.slow_slides

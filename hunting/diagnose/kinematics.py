@@ -50,7 +50,8 @@ class Kinematics:
     from these); spectrum : bool (n,) or None, the samples whose acceleration spectrum tells
     the band a resonance can be seen in (:func:`~hunting.diagnose.causes.flexibility.band`), None
     for ``moving`` (a record split into blocks keeps its whole record's: the sensor and the
-    motion are one)."""
+    motion are one); slow_slides : bool, the slides were read with :func:`kinematics`'
+    ``slow_slides`` rules."""
 
     t: np.ndarray
     q: np.ndarray
@@ -69,6 +70,7 @@ class Kinematics:
     noise: float = 0.0
     q_measured: np.ndarray | None = None
     spectrum: np.ndarray | None = None
+    slow_slides: bool = False
 
     @property
     def dt(self) -> float:
@@ -152,13 +154,15 @@ def _second_derivative_operator(w: int, dt: float) -> tuple[np.ndarray, np.ndarr
 
 def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.0, *,
                   half_time: float = 0.001, progress_samples: int = 0, progress_where=None,
-                  progress_velocity=None) -> np.ndarray:
+                  progress_velocity=None, regular_samples: int = 0, regular_velocity=None) -> np.ndarray:
     """bool (n,): the position stays within one count of ``resolution`` [m] (plus four standard
     deviations of the sensor ``noise`` [m]) over +-half_time [s] (at least 2 samples), and it has
     not progressed by a count in the same direction both over the last and over the next
     ``progress_samples`` samples (where ``progress_where``, bool (n,), allows; default
     everywhere), at a velocity ``progress_velocity`` (n,) [m/s] (when given) of that direction
-    and at least half a count per progress span.
+    and at least half a count per progress span; nor over the longer ``regular_samples`` where
+    its counts come regularly at the velocity ``regular_velocity`` (n,) [m/s] (a slide too slow
+    for the short span to see a count).
 
     The second condition keeps a slow slide a slide: at one count every few samples the
     position stays within one count over the short span (reporting7 d0385 slid at 1.5 mm/s with
@@ -175,21 +179,51 @@ def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.
     win = sliding_window_view(q, 2 * h + 1)
     still = np.zeros(n, bool)
     still[h:n - h] = (win.max(axis=1) - win.min(axis=1)) <= tol
+    q = np.asarray(q, dtype=float)
+    step = 0.99 * max(resolution, 0.0) + 4.0 * np.sqrt(2.0) * max(noise, 0.0) + 1e-15
+    where = None if progress_where is None else np.asarray(progress_where, bool)
     H = int(progress_samples)
     if H > h and n > 2 * H:
-        q = np.asarray(q, dtype=float)
-        back, ahead = q[H:n - H] - q[:n - 2 * H], q[2 * H:] - q[H:n - H]
-        step = 0.99 * max(resolution, 0.0) + 4.0 * np.sqrt(2.0) * max(noise, 0.0) + 1e-15
-        progress = (back * ahead > 0) & (np.minimum(np.abs(back), np.abs(ahead)) >= step)
-        if progress_where is not None:
-            progress &= np.asarray(progress_where, bool)[H:n - H]
-        if progress_velocity is not None:
-            # a pause of a few ms between counts is a stick, which a short-window velocity near
-            # zero (or of the other sign) tells (reporting7 d0109: 10 ms at one count amid 1-2 mm/s)
-            vel = np.asarray(progress_velocity, float)[H:n - H]
-            progress &= (vel * back > 0) & (np.abs(vel) * H * dt >= 0.5 * step)
-        still[H:n - H] &= ~progress
+        still[H:n - H] &= ~_progress(q, H, step, dt, where, progress_velocity)
+    G = int(regular_samples)
+    changes = np.flatnonzero(np.diff(q) != 0)
+    if G > max(h, H) and n > 2 * G and regular_velocity is not None and changes.size:
+        # where the short span sees less than a count, the long one: the counts must come as a
+        # steady slide at the long window's speed brings them, a gap between the counts around
+        # the sample of at most REGULAR_GAP count intervals at that speed (a stop of a few ms
+        # amid a slow motion leaves a longer one: reporting65 d0000 had 118 samples of its
+        # noise-free loop's sticks counted as slides without this)
+        vel = np.asarray(regular_velocity, float)
+        k = np.arange(n)
+        j = np.searchsorted(changes, k)           # first change at or after k (between k and k+1)
+        after = np.where(j < changes.size, changes[np.minimum(j, changes.size - 1)], n)
+        before = np.where(j > 0, changes[np.maximum(j - 1, 0)], -1)
+        gap = (after - before) * dt
+        regular = gap * np.abs(vel) <= REGULAR_GAP * max(resolution, 1e-15)
+        still[G:n - G] &= ~(_progress(q, G, step, dt, where, vel) & regular[G:n - G])
     return still
+
+
+# a count gap of at most this many count intervals at the long window's speed is a steady slide
+REGULAR_GAP = 2.0
+
+
+def _progress(q: np.ndarray, H: int, step: float, dt: float, where, velocity) -> np.ndarray:
+    """bool (n - 2H,), for samples H..n-H-1: the position has moved by at least ``step`` [m] in
+    one direction both over the last and over the next H samples, where ``where`` (bool (n,) or
+    None) allows, at a ``velocity`` (n,) [m/s] (when given) of that direction and at least half a
+    step per span."""
+    n = q.size
+    back, ahead = q[H:n - H] - q[:n - 2 * H], q[2 * H:] - q[H:n - H]
+    progress = (back * ahead > 0) & (np.minimum(np.abs(back), np.abs(ahead)) >= step)
+    if where is not None:
+        progress &= where[H:n - H]
+    if velocity is not None:
+        # a pause of a few ms between counts is a stick, which a short-window velocity near
+        # zero (or of the other sign) tells (reporting7 d0109: 10 ms at one count amid 1-2 mm/s)
+        vel = np.asarray(velocity, float)[H:n - H]
+        progress &= (vel * back > 0) & (np.abs(vel) * H * dt >= 0.5 * step)
+    return progress
 
 
 def position_noise(q: np.ndarray) -> float:
@@ -214,14 +248,20 @@ def dilate(mask: np.ndarray, half: int) -> np.ndarray:
 
 
 def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_min_frac: float = 0.02,
-               resolution: float | None = None, noise: float = 0.0, steady=None) -> Kinematics:
+               resolution: float | None = None, noise: float = 0.0, steady=None,
+               slow_slides: bool = False) -> Kinematics:
     """Smoothed derivatives of a measurement and the sliding samples (module docstring). window
     [s] defaults to 31 samples (31 ms at 1 kHz); resolution [m] (default: read from the data)
     and noise [m] of the position sensor decide which samples stick (noise 0 with positions that
     are not quantized and no resolution given: read from the data, :func:`position_noise`);
     steady : optional callable, velocities (n,) [m/s] -> bool (n,), where a slow slide is steady
     (:meth:`NominalModel.steady_slide`): only there does a position that progresses by a count
-    every few samples count as sliding (:func:`stuck_samples`; default everywhere)."""
+    every few samples count as sliding (:func:`stuck_samples`; default everywhere);
+    slow_slides : read slides too slow for the short span to see a count over half the long
+    window, where the counts come regularly, and give the friction map the long window's
+    velocity on a sliding sample where the short window's has the other sign (what the
+    diagnosis asks where the default reading leaves a record too few sliding samples:
+    :func:`~hunting.diagnose.parts.slow_slide_settings`)."""
     dt = meas.dt
     w = 31 if window is None else int(round(window / dt)) | 1
     if w < 5 or w > meas.n // 2:
@@ -246,8 +286,18 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     # contact's break-away, whose bristles the stick channel reads from it)
     fast = np.abs(v) > v_min_frac * np.max(np.abs(v))
     where = fast if steady is None else fast & steady(v)
+    # progress over the friction map's half span, or (slow_slides) over the long window's where a
+    # steady slide gains a count more slowly (independent seed 11 d0050: a ramp at 1.06 mm/s, a
+    # count of 2.9 um every 11 samples at 4 kHz, the short span 7 samples: 14 of 42350 samples slid)
     slide = ~stuck_samples(meas.q, dt, resolution, noise, progress_samples=wf // 2, progress_where=where,
-                           progress_velocity=vf)
+                           progress_velocity=vf, regular_samples=w // 2 if slow_slides else 0,
+                           regular_velocity=v if slow_slides else None)
+    # a slide's direction is its counts': where the short window's derivative has the other sign
+    # than the long window's on a sliding sample (counts a few ms apart, a cubic's edge weights),
+    # the map takes the long window's velocity (reporting65 d0016: Fc 29.6 N at the wrong sign
+    # on samples of a slow slide, 11.6 N RMS of residual there against 0.5 N elsewhere)
+    if slow_slides:
+        vf = np.where(slide & (vf * v <= 0), v, vf)
     H = lambda x: acceleration_filter(x, dt, w)  # noqa: E731
     force = H(drive)
     a = H(np.where(slide, a_inst, 0.0))
@@ -260,7 +310,7 @@ def kinematics(meas: Measurement, cm: float, *, window: float | None = None, v_m
     change[1:] = slide[1:] != slide[:-1]
     moving &= edge & ~dilate(change, w // 2)
     return Kinematics(meas.t, q, v, a, force, float(cm), w * dt, moving, vf, a_inst, drive, slide,
-                      held, float(resolution), float(noise), np.asarray(meas.q, float))
+                      held, float(resolution), float(noise), np.asarray(meas.q, float), slow_slides=bool(slow_slides))
 
 
 def reference_kinematics(meas: Measurement, model, *, window: float | None = None) -> Kinematics | None:

@@ -77,3 +77,100 @@ def _delay_margin(mass: float, cm: float, b: float, controller: tuple) -> float 
             return None
         margins.append(pm / wc)
     return float(min(margins))
+
+
+# a slide counts as steady on a falling branch down to this share of the slope the linear loop
+# tolerates: near that edge the loop rings for long after every disturbance, and the drive's
+# noise and the sensor's count, which the linear loop leaves out, can make a stick of it
+STEADY_SHARE = 0.5
+
+
+def steady_slope(model: NominalModel, dt: float) -> float:
+    """The most negative slope c [N s/m] of the friction curve (d F / d|v|: the Stribeck level's
+    slope plus the viscous coefficient) on which a steady slide of the model's closed loop is
+    stable, times STEADY_SHARE; 0 without a controller (the free mass needs c >= 0).
+
+    Sliding at a constant speed on a branch of slope c, the loop's small motions are those of the
+    linear plant m q'' + c q' = cm u under the model's sampled controller (``dt`` [s] the data's
+    sample interval, the controller's own sample time where it has one; zero-order hold; the
+    plant's delay is left out). A stiff loop holds a slide on a falling Stribeck branch that the
+    free mass would leave in stick-slip (the thesis's ch. 9: the PID's damping against the
+    curve's negative slope); the stability edge is found by bisection on the spectral radius of
+    the loop's transition matrix."""
+    c = model.controller
+    if not c:
+        return 0.0
+    items = tuple(sorted(c.items()))
+    try:
+        hash(items)
+    except TypeError:
+        return _steady_slope.__wrapped__(model.mass, model.cm, items, float(dt))
+    return _steady_slope(model.mass, model.cm, items, float(dt))
+
+
+@functools.lru_cache(maxsize=64)
+def _steady_slope(mass: float, cm: float, controller: tuple, dt: float) -> float:
+    from .resimulate import SampledController
+    ctrl = SampledController.from_schema(dict(controller))
+    T = dt if ctrl.sample_time is None else ctrl.sample_time
+
+    def stable(slope: float) -> bool:
+        return bool(np.max(np.abs(np.linalg.eigvals(_sampled_loop(mass, cm, ctrl, slope, T)))) < 1.0)
+
+    if not stable(0.0):
+        return 0.0
+    lo = -1.0
+    for _ in range(80):                   # the loop is unstable at a slope steep enough
+        if not stable(lo):
+            break
+        lo *= 2.0
+    else:
+        return 0.0
+    hi = 0.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if stable(mid) else (mid, hi)
+        if hi - lo <= 1e-6 * abs(lo):
+            break
+    return STEADY_SHARE * hi
+
+
+def steady_slide(model: NominalModel, dt: float):
+    """The callable v (n,) [m/s] -> bool (n,) that tells where a slow slide of the model's loop,
+    sampled every ``dt`` [s], is steady (:meth:`NominalModel.steady_slide` down to
+    :func:`steady_slope`): what the kinematics' ``steady`` takes."""
+    least = steady_slope(model, dt)
+    return lambda v: model.steady_slide(v, least)
+
+
+def _sampled_loop(mass: float, cm: float, ctrl, slope: float, T: float) -> np.ndarray:
+    """The transition matrix over one controller period T [s] of the loop's small motions about
+    a steady slide: plant m q'' + slope q' = cm u held over the period (exact zero-order hold),
+    and the controller's update as :func:`~hunting.diagnose.resimulate._control` makes it; the
+    state is the plant's q, v and the controller's (I, D and the last signal for a PID; the last
+    position and its filtered value for the PD + velocity loop), z_k+1 = step z_k."""
+    from scipy.linalg import expm
+    M = np.zeros((3, 3))
+    M[0, 1] = 1.0
+    M[1, 1] = -slope / mass
+    M[1, 2] = cm / mass
+    E = expm(M * T)
+    Ad, Bd = E[:2, :2], E[:2, 2]
+    if ctrl.kind == "pid":
+        # e_k = q_k (the reference's ramp is the slide); I_k = I_k-1 + T q_k; D_k = (tf D_k-1 +
+        # s_k - s_k-1) / (tf + T), s the error or the measurement (the same for small motions);
+        # u_k = -(kp q_k + kd D_k + ki I_k). z = [q, v, I, D, s]: the controller's states are
+        # updated from q_k first, then u_k acts over the period
+        g = 1.0 / (ctrl.tau_f + T)
+        update = np.array([[1, 0, 0, 0, 0], [0, 1, 0, 0, 0], [T, 0, 1, 0, 0], [g, 0, 0, ctrl.tau_f * g, -g],
+                           [1, 0, 0, 0, 0]], float)
+        u = -np.array([ctrl.kp, 0.0, ctrl.ki, ctrl.kd, 0.0]) @ update
+    else:
+        # qf_k = (q_k + y_k-1) / 2; u_k = kv (-kp q_k - (qf_k - qf_k-1) / T); z = [q, v, y, qf]
+        # (the last measurement and its filtered value)
+        update = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [1, 0, 0, 0], [0.5, 0, 0.5, 0]], float)
+        u = ctrl.kv * np.array([-ctrl.kp - 0.5 / T, 0.0, -0.5 / T, 1.0 / T])
+    step = update.copy()
+    step[:2, :2] = Ad
+    step[:2, :] += np.outer(Bd, u)
+    return step

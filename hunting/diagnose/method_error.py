@@ -60,13 +60,14 @@ def method_error(meas: Measurement, kin: Kinematics, model) -> MethodError | Non
     """
     if model.controller is None or meas.q_ref is None:
         return None
+    from .parts import sensor_settings, slow_slide_settings
     from .resimulate import resimulate
     sim = resimulate(meas, model, sensor_noise=0.0)
     if not sim.ok:
         return None
     own = Measurement(meas.t, sim.q, sim.u, meas.q_ref, meas.f_ext, name=meas.name + " (nominal loop, noise-free)")
-    ks = kinematics(own, model.cm, window=kin.window, resolution=kin.resolution, noise=kin.noise,
-                    steady=model.steady_slide)
+    settings = slow_slide_settings(model, meas.dt) if kin.slow_slides else sensor_settings(model)
+    ks = kinematics(own, model.cm, window=kin.window, **dict(settings, resolution=kin.resolution, noise=kin.noise))
     valid = kin.moving & used_samples(ks, model) & (np.abs(ks.v - kin.v) <= TRACK * np.abs(kin.v))
     if valid.sum() < 100:
         return None

@@ -301,15 +301,17 @@ class NominalModel:
         the shape a seven-parameter dwell growth decays along (:class:`Dwell` ``sliding``)."""
         return all(c.Fs > c.Fc and not c.discontinuous for c in (self.curve.positive, self.curve.negative))
 
-    def steady_slide(self, v) -> np.ndarray:
+    def steady_slide(self, v, least: float = 0.0) -> np.ndarray:
         """bool (n,): where the static curve's slope d F / d|v| (Stribeck level and viscous term,
-        per direction) is not negative at velocities v (n,) [m/s]: a slow slide there is steady.
-        On the falling branch of a Stribeck dip a slow motion is stick-slip below the encoder's
-        count (tuning d0042 progressed one count per 20 ms at 0.5 mm/s with vs = 4 mm/s while its
-        drive ramped as in a stick)."""
+        per direction) at velocities v (n,) [m/s] is at least ``least`` [N s/m] (<= 0): a slow
+        slide there is steady. The free mass needs a slope that is not negative: on the falling
+        branch of a Stribeck dip a slow motion is stick-slip below the encoder's count (tuning
+        d0042 progressed one count per 20 ms at 0.5 mm/s with vs = 4 mm/s while its drive ramped
+        as in a stick); a controller holds a slide down to the slope its loop tolerates
+        (:func:`~hunting.diagnose.loop.steady_slope`)."""
         v = np.asarray(v, dtype=float)
         pos, neg = self.curve.positive, self.curve.negative
-        return np.where(v >= 0, pos.level_slope(v) + pos.b, neg.level_slope(v) + neg.b) >= 0
+        return np.where(v >= 0, pos.level_slope(v) + pos.b, neg.level_slope(v) + neg.b) >= least
 
     def cogging_force(self, q) -> np.ndarray:
         """F_cog(q) [N]: the sum of the components (0 without cogging)."""
