@@ -521,15 +521,19 @@ def test_the_band_scan_keeps_the_best_grid_point_of_each_damping_ratio():
 
 
 def test_a_fitting_record_that_hardly_slides_gives_way_to_the_validation_record():
-    """reporting9 d0398: the fitting record creeps at 0.3 mm/s and has 56 sliding samples; the
-    validation record's sine and move hold an offset of 79 % of its residual. Fitted on the
-    creeping record every cause was unphysical or unidentified and nothing was reported; the
-    validation record split 60/40 finds the offset, and the report says so."""
+    """reporting9 d0398: the fitting record creeps at 0.3 mm/s and, read as the free mass reads
+    it, has no usable sample; the validation record's sine and move hold an offset of 79 % of its
+    residual. The validation record split 60/40 in time gives two parts the force channel can use
+    (the diagnosis now reads the creep as slides first: the previous test)."""
+    from hunting.diagnose.parts import informative, sensor_settings, split_validation
     fit, val, model, truth = _dataset("reporting9", 398)
-    d = diagnose(fit, model, val, behaviour=False)
-    assert [c.name for c in d.causes] == ["offset"], [(c.name, c.parameters) for c in d.causes]
-    assert d.causes[0].parameters["offset"] == pytest.approx(truth["effects"][0]["params"]["offset"], rel=0.05)
-    assert any("first 60 % of the validation data" in n for n in d.notes), d.notes
+    kf, kv = _used_kinematics(fit, val, model)
+    assert not informative(kf) and informative(kv)
+    parts = split_validation(val, model, sensor_settings(model), None)
+    assert parts is not None
+    first, last, _, kfirst, klast = parts
+    assert first.n + last.n == val.n and first.t[-1] < last.t[0]
+    assert informative(kfirst) and informative(klast)
 
 
 def test_a_validation_record_that_ends_at_rest_is_split_into_alternate_blocks():
@@ -1247,15 +1251,15 @@ def test_noise_fed_cause_must_explain_along_the_noise_free_loop(index, cause, wo
     assert any(w in reason for w in words), reason
 
 
-@pytest.mark.parametrize("family, index, name, key, rel", [("reporting15", 439, "level", "scale", 0.03),
-                                                            ("reporting14", 314, "offset", "offset", 0.1)])
+@pytest.mark.parametrize("family, index, name, key, rel", [("reporting14", 314, "offset", "offset", 0.1)])
 def test_a_record_that_mostly_sticks_names_its_cause_by_the_loop(family, index, name, key, rel):
-    """Records whose loop slides too little for the force balance (fewer than 100 usable samples:
-    the force channel is skipped): reporting15 d0439, Fc and Fs 1.87 times the model's, and
-    reporting14 d0314, a constant force of -1.83 N. Each candidate's one parameter fitted on the
-    fitting record's re-simulated loop: the true cause cuts both records' position error by more
-    than LOOP_GAIN (the start code reported nothing for either), its parameter within ``rel``;
-    the other candidates are rejected at the loop step."""
+    """A record whose loop slides too little for the force balance (fewer than 100 usable samples
+    under either reading of its slides: the force channel is skipped): reporting14 d0314, a
+    constant force of -1.83 N. Each candidate's one parameter fitted on the fitting record's
+    re-simulated loop: the true cause cuts both records' position error by more than LOOP_GAIN
+    (the start code reported nothing), its parameter within ``rel``; the other candidates are
+    rejected at the loop step. (reporting15 d0439, Fc and Fs 1.87 times the model's, was named
+    this way until its slow slides were read as its loop holds them: see the next test.)"""
     from hunting.diagnose.causes.presliding import LOOP_GAIN
     fit, val, model, truth = _dataset(family, index)
     d = diagnose(fit, model, val, behaviour=False, causes=["offset", "level", "viscous", "mass", "delay", "lag"])
@@ -1267,6 +1271,26 @@ def test_a_record_that_mostly_sticks_names_its_cause_by_the_loop(family, index, 
     assert d.extended_model.to_dict() != model.to_dict()
     rows = [r for r in d.rejected if r.get("step") == "loop"]
     assert rows and all(r["reason"].startswith("fewer than 100 sliding samples") for r in rows)
+
+
+def test_slow_slides_the_loop_holds_are_read_where_the_default_reading_leaves_too_few():
+    """reporting15 d0439 (Fc and Fs 1.87 times the model's; its loop held slow slides on the
+    falling branch, which the free mass's rule read as sticks: the force channel was skipped and
+    the level named from the loop): read as its loop holds them, the force channel names the
+    change itself (as a Stribeck change, which the benchmark accepts for a level), Fc within 3 %,
+    at a p-value, and the report says how the slides were read. reporting9 d0398 (a fitting
+    record creeping at 0.3 mm/s with no usable sample, an offset; the validation record's 60/40
+    split found it within 5 %): the creep reads as slides, and the offset is named from the
+    fitting record within 1 %."""
+    for family, index, key, rel in (("reporting15", 439, "Fc", 0.03), ("reporting9", 398, "offset", 0.01)):
+        fit, val, model, truth = _dataset(family, index)
+        d = diagnose(fit, model, val, behaviour=False)
+        assert len(d.causes) == 1 and d.causes[0].name in truth["effects"][0]["accept"], [
+            (c.name, c.parameters) for c in d.causes]
+        c = d.causes[0]
+        assert c.parameters[key] == pytest.approx(truth["effects"][0]["params"][key], rel=rel)
+        assert c.p_value is not None and c.p_value < 1e-3
+        assert any(n.startswith("slow slides read as the model's loop holds them") for n in d.notes), d.notes
 
 
 def test_a_clean_record_that_mostly_sticks_gets_nothing_from_the_loop():
