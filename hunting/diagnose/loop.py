@@ -95,8 +95,8 @@ def steady_slope(model: NominalModel, dt: float) -> float:
     sample interval, the controller's own sample time where it has one; zero-order hold; the
     plant's delay is left out). A stiff loop holds a slide on a falling Stribeck branch that the
     free mass would leave in stick-slip (the thesis's ch. 9: the PID's damping against the
-    curve's negative slope); the stability edge is found by bisection on the spectral radius of
-    the loop's transition matrix."""
+    curve's negative slope); the stability edge is where the spectral radius of the loop's
+    transition matrix reaches 1 (bracketed by doubling the slope, then scipy's brentq)."""
     c = model.controller
     if not c:
         return 0.0
@@ -114,25 +114,18 @@ def _steady_slope(mass: float, cm: float, controller: tuple, dt: float) -> float
     ctrl = SampledController.from_schema(dict(controller))
     T = dt if ctrl.sample_time is None else ctrl.sample_time
 
-    def stable(slope: float) -> bool:
-        return bool(np.max(np.abs(np.linalg.eigvals(_sampled_loop(mass, cm, ctrl, slope, T)))) < 1.0)
+    def excess(slope: float) -> float:
+        """The loop's spectral radius less 1 (negative: stable)."""
+        return float(np.max(np.abs(np.linalg.eigvals(_sampled_loop(mass, cm, ctrl, slope, T))))) - 1.0
 
-    if not stable(0.0):
+    if excess(0.0) >= 0:
         return 0.0
-    lo = -1.0
-    for _ in range(80):                   # the loop is unstable at a slope steep enough
-        if not stable(lo):
-            break
-        lo *= 2.0
-    else:
+    # the first slope of a doubling series at which the loop is unstable brackets the edge
+    steep = next((c for c in -np.geomspace(1.0, 2.0 ** 80, 81) if excess(c) > 0), None)
+    if steep is None:
         return 0.0
-    hi = 0.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if stable(mid) else (mid, hi)
-        if hi - lo <= 1e-6 * abs(lo):
-            break
-    return STEADY_SHARE * hi
+    from scipy.optimize import brentq
+    return STEADY_SHARE * brentq(excess, steep, 0.0, rtol=1e-8)
 
 
 def steady_slide(model: NominalModel, dt: float):
