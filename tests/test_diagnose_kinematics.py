@@ -183,6 +183,28 @@ def test_the_steady_slope_is_the_sampled_loops_stability_edge(kp, kd, ki, tau_f,
     assert steady_slope(free, T) == 0.0
 
 
+def test_the_steady_slope_of_the_pd_velocity_loop_is_its_stability_edge():
+    """The PD + velocity loop (u = kv (kp (r - y) - (qf_k - qf_k-1) / T), qf the mean of the last
+    two measurements): python-control's closed loop with that controller, kv (kp + (z^2 - 1) /
+    (2 T z^2)), has its largest pole inside the unit circle 1 % on the safe side of the edge and
+    outside 1 % beyond it."""
+    import control as ct
+    from hunting.diagnose import NominalModel
+    from hunting.diagnose.loop import STEADY_SHARE, steady_slope
+    mass, cm, kp, kv, T = 15.0, 1.33, 160.18, 243.45, 1e-3
+    model = NominalModel.from_dict({"plant": {"mass": mass, "motor_constant": cm},
+                                    "friction": {"law": "stribeck", "Fc": 1.0, "Fs": 1.5, "vs": 0.003, "b": 0.0},
+                                    "controller": {"type": "pd-velocity-loop", "kp": kp, "kv": kv}})
+    edge = steady_slope(model, T) / STEADY_SHARE
+    z = ct.tf([1, 0], [1], T)
+    C = kv * (kp + (z * z - 1) / (2 * T * z * z))
+
+    def rho(c):
+        return float(np.max(np.abs(ct.poles(ct.feedback(ct.c2d(ct.tf([cm], [mass, c, 0]), T, "zoh") * C, 1)))))
+    assert edge < 0
+    assert rho(0.99 * edge) < 1.0 < rho(1.01 * edge)
+
+
 def test_a_stiff_loop_holds_a_slow_slide_on_the_falling_branch():
     """Independent seed 11 d0050's case: a ramp at 0.09 counts per sample (a count every 11
     samples) inside a Stribeck dip, under a PID whose damping outweighs the curve's negative

@@ -186,8 +186,8 @@ def stuck_samples(q: np.ndarray, dt: float, resolution: float, noise: float = 0.
     if H > h and n > 2 * H:
         still[H:n - H] &= ~_progress(q, H, step, dt, where, progress_velocity)
     G = int(regular_samples)
-    changes = np.flatnonzero(np.diff(q) != 0)
-    if G > max(h, H) and n > 2 * G and regular_velocity is not None and changes.size:
+    changes = np.flatnonzero(np.diff(q) != 0) if G > max(h, H) and n > 2 * G and regular_velocity is not None else ()
+    if len(changes):
         # where the short span sees less than a count, the long one: the counts must come as a
         # steady slide at the long window's speed brings them, a gap between the counts around
         # the sample of at most REGULAR_GAP count intervals at that speed (a stop of a few ms

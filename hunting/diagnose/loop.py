@@ -36,13 +36,18 @@ def delay_margin(model: NominalModel) -> float | None:
     if not c:
         return None
     b = max(0.5 * (model.curve.positive.b + model.curve.negative.b), 0.0)
-    items = tuple(sorted(c.items()))
-    try:
-        hash(items)
-    except TypeError:                      # a controller value that is not hashable: not cached
-        return _delay_margin.__wrapped__(model.mass, model.cm, b, items)
     # the force channel's search asks once per fitted delay (289 times on one record, 8 % of it)
-    return _delay_margin(model.mass, model.cm, b, items)
+    return _cached(_delay_margin, model.mass, model.cm, b, tuple(sorted(c.items())))
+
+
+def _cached(fn, *args):
+    """fn(*args) through its lru_cache, or past it where an argument (a controller value) is not
+    hashable."""
+    try:
+        hash(args)
+    except TypeError:
+        return fn.__wrapped__(*args)
+    return fn(*args)
 
 
 @functools.lru_cache(maxsize=64)
@@ -100,12 +105,7 @@ def steady_slope(model: NominalModel, dt: float) -> float:
     c = model.controller
     if not c:
         return 0.0
-    items = tuple(sorted(c.items()))
-    try:
-        hash(items)
-    except TypeError:
-        return _steady_slope.__wrapped__(model.mass, model.cm, items, float(dt))
-    return _steady_slope(model.mass, model.cm, items, float(dt))
+    return _cached(_steady_slope, model.mass, model.cm, tuple(sorted(c.items())), float(dt))
 
 
 @functools.lru_cache(maxsize=64)
