@@ -29,6 +29,14 @@ GONE = 0.05           # merged amplitude below 5 % of the model's: the model's c
 # band (flexibility.UNSEEN_FACTOR): at 2, 93 of reporting36's 636 records paid the validation-only
 # search for pitches of which the validation record holds 1.5-3 periods; at 3, 37
 UNSEEN_FACTOR = 3.0
+# the friction curve's possible errors the pitch search fits beside the harmonics (per direction: a
+# level, a slope, and Stribeck dips of this many widths spanning the record's sliding speeds): a
+# curve error left in the residual is not periodic in position but, over a stroke of a few pitches
+# travelled at changing speeds, it leaks into the harmonics and pulls the pitch (reporting66
+# d0546: a Stribeck change beside a 5.56 mm cogging moved the best pitch to the search's -1 %
+# edge, 11 periods away the validation record's phase was 40 degrees off and the cogging
+# predicted it 6 % worse; fitted beside the curve terms, +0.2 % and a valley 100 times deeper)
+CURVE_DIPS = 4
 
 
 def matched(model, pitch: float) -> int | None:
@@ -57,7 +65,8 @@ def model_coefficients(model, pitch: float) -> np.ndarray:
 
 def hypers(kin, model) -> list:
     """Pitch candidates: the three strongest peaks of the Lomb-Scargle spectrum of the nominal
-    force residual (averaged in position bins) against position (wavelengths from 20 samples'
+    force residual less its fit by the friction curve's error terms (:func:`curve_terms`;
+    averaged in position bins) against position (wavelengths from 20 samples'
     travel at the slow end of the record's speeds (10th percentile) to the stroke over
     MIN_PERIODS), and the longest of these wavelengths where the spectrum falls from it; each
     refined on a +-3 % grid of the binned residual, then on the cause's filtered design
@@ -71,7 +80,7 @@ def hypers(kin, model) -> list:
     moving = kin.moving
     if moving.sum() < 50:
         return []
-    r_all = residual(kin, model)
+    r_all = _without_curve(kin, residual(kin, model))
     q, r = kin.q[moving], r_all[moving]
     travel = stroke(kin)
     # short pitches show where the motion is slow (a pitch shorter than 20 samples' travel at the
@@ -125,9 +134,39 @@ def hypers(kin, model) -> list:
     return sorted(out, key=lambda h: h["pitch"])
 
 
+def curve_terms(kin) -> np.ndarray:
+    """Regressors of the friction curve's possible errors [-, m/s] (n, 2 (2 + CURVE_DIPS)) as the
+    force channel sees them (:meth:`Kinematics.sliding`): per direction of the filtered velocity
+    its indicator, the velocity itself and exp(-(v / vs)^2) for CURVE_DIPS widths vs geometric
+    between the 10th and 90th percentiles of the sliding speeds."""
+    v = kin.vf
+    speed = np.abs(v[kin.slide & (v != 0)])
+    if speed.size < 10:
+        return np.zeros((v.size, 0))
+    widths = np.geomspace(*np.percentile(speed, [10, 90]), CURVE_DIPS)
+    cols = []
+    for side in (v > 0, v < 0):
+        cols += [side * 1.0, side * v] + [side * np.exp(-(v / w) ** 2) for w in widths]
+    return kin.sliding(np.column_stack(cols))
+
+
+def _without_curve(kin, r: np.ndarray) -> np.ndarray:
+    """The residual r (n,) [N] less its least-squares fit by :func:`curve_terms` on the moving
+    samples (elsewhere unchanged): what the friction curve's errors leave of it."""
+    m = kin.moving
+    C = curve_terms(kin)[m]
+    if not C.shape[1]:
+        return r
+    th, *_ = np.linalg.lstsq(C, r[m], rcond=None)
+    out = r.copy()
+    out[m] = r[m] - C @ th
+    return out
+
+
 def _refined(kin, model, r, pitch: float) -> float:
-    """The pitch [m] within +-1 % of ``pitch`` whose filtered harmonics (the cause's design) fit
-    the residual r (n,) [N] best on the moving samples: a 0.2 % grid, then the vertex of the
+    """The pitch [m] within +-1 % of ``pitch`` whose filtered harmonics (the cause's design),
+    beside the friction curve's error terms (:func:`curve_terms`), fit the residual r (n,) [N]
+    best on the moving samples: a 0.2 % grid, then the vertex of the
     parabola through the best point and its neighbours (the valley is quadratic over a few tenths
     of a percent; each point costs a filtered design, 0.45 s of a 7.7 s diagnosis at 0.05 %).
 
@@ -137,10 +176,11 @@ def _refined(kin, model, r, pitch: float) -> float:
     gain fell from 7 % to 5 %), where the filtered design's minimum is sharp at the truth."""
     m = kin.moving
     y = r[m]
+    C = curve_terms(kin)[m]
     grid = pitch * np.linspace(0.99, 1.01, 11)
     rss = []
     for p in grid:
-        X = design(kin, model, {"pitch": float(p)})[m]
+        X = np.column_stack([design(kin, model, {"pitch": float(p)})[m], C])
         th, *_ = np.linalg.lstsq(X, y, rcond=None)
         rss.append(float(np.sum((y - X @ th) ** 2)))
     i = int(np.argmin(rss))
