@@ -15,7 +15,10 @@ Nelder-Mead on log gain and log time, at most GAINS x TIMES + EVALS re-simulatio
 below, a fine line in the gain at each of the grid's times before it, TIMES x LINE more).
 
 - The parameters: of the break-away reading's fit and the loop's, the one that re-simulates the
-  fitting record better, the loop's only where it beats the nominal model there (:func:`refine`).
+  fitting record better, the loop's only where it beats the nominal model there (:func:`refine`;
+  where the loop's fit from the readings and the grid fails the fitting record's prompted bar,
+  a fine line in the gain is tried too: the readings' gain can lie outside a valley a few
+  percent wide).
   On the development sets reporting13-16 (16 dwell records the growth test found) the gain was
   within 10 % of the truth in 5 with the reading's fit alone and in 10 with the loop's
   (reporting13 d0394: 29 times off, 0.45 off on the loop). The break-away metric is then computed
@@ -122,8 +125,9 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
     Nelder-Mead); ``grid`` False: Nelder-Mead from ``start`` alone; ``sliding``: the growth's form
     (:class:`~hunting.diagnose.model.Dwell`; None: the model's own, and where it has none each
     form it can hold, :func:`forms`, the one with the smaller error taken);
-    ``line``: a fine line in the gain (LINE points over LINE_RANGE times the grid's best gain at
-    that time) at every time of the grid, and the best of their points, before Nelder-Mead;
+    ``line``: a fine line in the gain (LINE points over LINE_RANGE times the best gain at that
+    time) at every time of the grid and ``start``'s, and the best of their points, before
+    Nelder-Mead;
     ``readings``: (t_k (k,) [s], e_k (k,) [N]), break-aways read on ``meas`` (rest times and
     excesses over the model's break-away force): where the grid's best is not below ``floor``,
     their least-squares gain at each time of the grid is tried (:func:`reading_gain`)."""
@@ -182,7 +186,7 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
             # from the grid's best time, 0.41 s, 54 % of the fitting record's error cut and 1 % of
             # the validation record's; from its shortest, 90 ms, 1.38 N over 80 ms cuts 72 and 68 %)
             steps = np.log(np.geomspace(*LINE_RANGE, LINE))
-            columns = [best([p for p in points if p[1] == lt]) for lt in times]
+            columns = [best([p for p in points if p[1] == lt]) for lt in {*times, *(p[1] for p in points)}]
             x0 = best([x0] + [(c[0] + d, c[1]) for c in columns for d in steps])
         # from a start alone, a simplex of fixed steps in log gain and log time (scipy's default,
         # 5 % of |x0|, is tiny near log 1 = 0: a refit from the other record's values hardly moved)
@@ -243,6 +247,15 @@ def refine(growth: dict, fit_meas, model, rest_times, val_meas=None) -> tuple[di
     # 9.22 -> 1.66 N against a true 9.28 N; the independent seed-10 d0088: 2.73 N against 1.28 N)
     alone = growth.get("p_value") is not None and growth["p_value"] < READINGS_ALONE and model.dwell is None
     ext, f_loop = fit(fit_meas, model, rest_times, (d.gain, d.time), sliding=False if alone else None)
+    if not f_loop <= f0 * (1.0 - PROMPTED_FIT_GAIN):
+        # where that fit fails the fitting record's bar, the readings' gain may lie outside the
+        # loop's valley, which where every rest outlasts the growth is a few percent wide in the
+        # gain: a fine line in the gain at the start's time and the grid's (reporting66 d0310, a
+        # 0.52 N growth over 34 ms read as 0.42 N: the fit ended at 0.32 N, 2 % of the error cut;
+        # the truth cuts 86 %, 0.9 times it -76 %, 1.1 times it 17 %)
+        lined = fit(fit_meas, model, rest_times, (d.gain, d.time), sliding=False if alone else None, line=True)
+        if lined[1] < f_loop:
+            ext, f_loop = lined
     loop = dict(model=ext, fit=(f0, f_loop), reading=f_read)
     # the loop's fit must see the growth (re-simulate the record better than the nominal model) as
     # well as beat the readings' (reporting14 d0506: the loop's best fit was 0.8 % worse than the
