@@ -80,7 +80,8 @@ def hypers(kin, model) -> list:
     moving = kin.moving
     if moving.sum() < 50:
         return []
-    r_all = _without_curve(kin, residual(kin, model))
+    C = curve_terms(kin)[moving]          # once: the refinements below fit beside the same terms
+    r_all = _without_curve(kin, residual(kin, model), C)
     q, r = kin.q[moving], r_all[moving]
     travel = stroke(kin)
     # short pitches show where the motion is slow (a pitch shorter than 20 samples' travel at the
@@ -122,7 +123,7 @@ def hypers(kin, model) -> list:
             fits.append((float(np.sum((rb - rb.mean() - A @ th) ** 2)), pitch))
         best = min(s for s, _ in fits)
         coarse = next(p for s, p in fits if s <= best * (1 + 1e-3))
-        out.append({"pitch": _refined(kin, model, r_all, coarse)})
+        out.append({"pitch": _refined(kin, model, r_all, coarse, C)})
     # two of the strongest peaks close either side of a wavenumber: the sidebands of a cogging
     # whose amplitude in the residual changes along the stroke (the filter passes it where the
     # motion is slow, not where it is fast); the carrier between them, refined on the filtered
@@ -130,7 +131,7 @@ def hypers(kin, model) -> list:
     top = sorted(i for i in peaks if i != 0)
     for a, b in zip(top, top[1:]):
         if k[b] / k[a] <= SIDEBANDS:
-            out.append({"pitch": _refined(kin, model, r_all, float(2.0 / (k[a] + k[b])))})
+            out.append({"pitch": _refined(kin, model, r_all, float(2.0 / (k[a] + k[b])), C)})
     return sorted(out, key=lambda h: h["pitch"])
 
 
@@ -150,11 +151,12 @@ def curve_terms(kin) -> np.ndarray:
     return kin.sliding(np.column_stack(cols))
 
 
-def _without_curve(kin, r: np.ndarray) -> np.ndarray:
+def _without_curve(kin, r: np.ndarray, C: np.ndarray | None = None) -> np.ndarray:
     """The residual r (n,) [N] less its least-squares fit by :func:`curve_terms` on the moving
-    samples (elsewhere unchanged): what the friction curve's errors leave of it."""
+    samples (elsewhere unchanged): what the friction curve's errors leave of it. ``C``: those
+    terms on the moving samples, where already formed."""
     m = kin.moving
-    C = curve_terms(kin)[m]
+    C = curve_terms(kin)[m] if C is None else C
     if not C.shape[1]:
         return r
     th, *_ = np.linalg.lstsq(C, r[m], rcond=None)
@@ -163,10 +165,10 @@ def _without_curve(kin, r: np.ndarray) -> np.ndarray:
     return out
 
 
-def _refined(kin, model, r, pitch: float) -> float:
+def _refined(kin, model, r, pitch: float, C: np.ndarray) -> float:
     """The pitch [m] within +-1 % of ``pitch`` whose filtered harmonics (the cause's design),
     beside the friction curve's error terms (:func:`curve_terms`), fit the residual r (n,) [N]
-    best on the moving samples: a 0.2 % grid, then the vertex of the
+    best on the moving samples (``C``: those terms there): a 0.2 % grid, then the vertex of the
     parabola through the best point and its neighbours (the valley is quadratic over a few tenths
     of a percent; each point costs a filtered design, 0.45 s of a 7.7 s diagnosis at 0.05 %).
 
@@ -176,7 +178,6 @@ def _refined(kin, model, r, pitch: float) -> float:
     gain fell from 7 % to 5 %), where the filtered design's minimum is sharp at the truth."""
     m = kin.moving
     y = r[m]
-    C = curve_terms(kin)[m]
     grid = pitch * np.linspace(0.99, 1.01, 11)
     rss = []
     for p in grid:
