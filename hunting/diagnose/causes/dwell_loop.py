@@ -116,7 +116,7 @@ def form_words(dwell) -> str:
 
 def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None = None,
         grid: bool = True, sliding: bool | None = None, line: bool = False,
-        readings: tuple | None = None) -> tuple[object, float]:
+        readings: tuple | None = None, caches: dict | None = None) -> tuple[object, float]:
     """(model, error): ``model`` with the dwell growth (gain [N], time [s]; level the model's)
     that minimizes the re-simulated position RMS error [m] on ``meas``, and that error (inf where
     nothing re-simulates). ``rest_times`` (m,) [s]: the record's rests, which span the time grid;
@@ -130,20 +130,22 @@ def fit(meas, model, rest_times, start: tuple | None = None, floor: float | None
     Nelder-Mead;
     ``readings``: (t_k (k,) [s], e_k (k,) [N]), break-aways read on ``meas`` (rest times and
     excesses over the model's break-away force): where the grid's best is not below ``floor``,
-    their least-squares gain at each time of the grid is tried (:func:`reading_gain`)."""
+    their least-squares gain at each time of the grid is tried (:func:`reading_gain`);
+    ``caches``: {form: {(log gain, log time): error}}, shared by fits of one record (a refit
+    re-simulates no point again, and returns the best of every point either fit tried)."""
     from scipy.optimize import minimize
 
     from ..loop_grid import cached_errors
     if sliding is None and model.dwell is None:
         # no form in the model: both fitted, the one that follows the fitting record better taken
         # (Kato's on a tie); see FORMS
-        kw = dict(start=start, floor=floor, grid=grid, line=line, readings=readings)
+        kw = dict(start=start, floor=floor, grid=grid, line=line, readings=readings, caches=caches)
         return min((fit(meas, model, rest_times, sliding=form, **kw) for form in forms(model)), key=lambda r: r[1])
     Fs = max(model.curve.positive.Fs, model.curve.negative.Fs)
     t = np.asarray(rest_times, float)
     if not (Fs > 0 and t.size and np.all(t > 0)):
         return model, np.inf
-    cache = {}
+    cache = {} if caches is None else caches.setdefault(sliding, {})
 
     def key(x):
         return round(float(x[0]), 9), round(float(x[1]), 9)
@@ -246,16 +248,17 @@ def refine(growth: dict, fit_meas, model, rest_times, val_meas=None) -> tuple[di
     # model's form: the other form fitted there moved gains far off (reporting65 d0559, p = 5e-5:
     # 9.22 -> 1.66 N against a true 9.28 N; the independent seed-10 d0088: 2.73 N against 1.28 N)
     alone = growth.get("p_value") is not None and growth["p_value"] < READINGS_ALONE and model.dwell is None
-    ext, f_loop = fit(fit_meas, model, rest_times, (d.gain, d.time), sliding=False if alone else None)
+    caches = {}
+    ext, f_loop = fit(fit_meas, model, rest_times, (d.gain, d.time), sliding=False if alone else None, caches=caches)
     if not f_loop <= f0 * (1.0 - PROMPTED_FIT_GAIN):
         # where that fit fails the fitting record's bar, the readings' gain may lie outside the
         # loop's valley, which where every rest outlasts the growth is a few percent wide in the
         # gain: a fine line in the gain at the start's time and the grid's (reporting66 d0310, a
         # 0.52 N growth over 34 ms read as 0.42 N: the fit ended at 0.32 N, 2 % of the error cut;
         # the truth cuts 86 %, 0.9 and 1.1 times its gain 28 and 17 %)
-        lined = fit(fit_meas, model, rest_times, (d.gain, d.time), sliding=False if alone else None, line=True)
-        if lined[1] < f_loop:
-            ext, f_loop = lined
+        # (the first fit's points cached: the best of both fits is returned)
+        ext, f_loop = fit(fit_meas, model, rest_times, (d.gain, d.time), sliding=False if alone else None,
+                          line=True, caches=caches)
     loop = dict(model=ext, fit=(f0, f_loop), reading=f_read)
     # the loop's fit must see the growth (re-simulate the record better than the nominal model) as
     # well as beat the readings' (reporting14 d0506: the loop's best fit was 0.8 % worse than the
