@@ -482,6 +482,23 @@ def test_cogging_pitch_beside_a_friction_curve_change():
     assert p["amplitude_1"] == pytest.approx(e["amplitude_1"], rel=0.05)
 
 
+def test_validation_only_search_keeps_a_found_pitch():
+    """reporting67 d0600: a 2.54 mm cogging (0.41 N) beside a small lag, found on the 10.3 mm
+    fitting stroke at 2.56 mm. The validation record's blocks (3.3 mm, 1.3 periods of it), on
+    which the validation-only search refits the found causes, have pitch candidates only at 2.31
+    mm and shorter; with the longest-wavelength candidate screened (1.16 mm and shorter) the
+    cogging failed there and a level asymmetry was named in its place. Refitted at the pitch it was
+    found at, the cogging is named, pitch within 1.5 % and amplitude within 5 %."""
+    fit, val, model, truth = _dataset("reporting67", 600)
+    e = next(x for x in truth["effects"] if x["cause"] == "cogging")["params"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes][:1] == ["cogging"], [(c.name, c.parameters) for c in d.causes]
+    assert "level_asymmetry" not in [c.name for c in d.causes]
+    p = d.causes[0].parameters
+    assert p["pitch"] == pytest.approx(e["pitch"], rel=0.015)
+    assert p["amplitude_1"] == pytest.approx(e["amplitude_1"], rel=0.05)
+
+
 def test_curve_terms_remove_a_friction_curve_error_and_keep_a_periodic_force():
     """cogging._without_curve on a known residual: a level, a viscous and a Stribeck error per
     direction (of widths other than the basis's) leave less than 2 % of their RMS; a periodic force

@@ -170,12 +170,7 @@ def test_reversal_identification_judges_the_refined_scale():
 
 @pytest.mark.parametrize("index, name, key, truth_key", [(78, "asymmetry", "b_neg", "b_neg"),
                                                          (57, "cogging", "amplitude_1", "A"),
-                                                         pytest.param(50, "level_asymmetry", "Fc_neg", "Fc_neg", marks=pytest.mark.xfail(
-                                                             strict=True, reason=(
-                                                                 "lost in the fifty-second session with the cogging pitch searched beside "
-                                                                 "the friction curve's terms (85577f4): the search still finds the level "
-                                                                 "asymmetry (Fc_neg 1.042 against the model's 1.309), but its out-of-sample "
-                                                                 "test gives p = 0.02 where it had passed; a lead")))])
+                                                         (50, "level_asymmetry", "Fc_neg", "Fc_neg")])
 def test_a_slow_slide_held_by_a_stiff_loop_is_read_as_a_slide(tmp_path, index, name, key, truth_key):
     """Seed 11 (held out in the fiftieth session, looked at in the fifty-first): records that move
     at 1-3 mm/s inside their model's Stribeck dip under PIDs whose damping outweighs the curve's

@@ -144,11 +144,12 @@ class Library:
     """Every testable force-channel cause with its variants, and the whitened Gram matrix of
     all their regressors on the thinned fitting data. method_error : (fitting, validation)
     :class:`~hunting.diagnose.method_error.MethodError` or None each, subtracted from the
-    records' residuals."""
+    records' residuals. known : {cause: [hyper-parameters]} found on another record, variants
+    beside the record's own candidates."""
 
     def __init__(self, names, kf: Kinematics, kv: Kinematics, model: NominalModel, used_f, used_v, step: int,
                  kr: Kinematics | None = None, instrument=None, method_error=(None, None),
-                 kfr: Kinematics | None = None):
+                 kfr: Kinematics | None = None, known: dict | None = None):
         self.model = model
         # kr, kfr: the validation and fitting records' instrument trajectories (the nominal loop
         # re-simulated without noise, :func:`~hunting.diagnose.kinematics.reference_kinematics`)
@@ -175,6 +176,14 @@ class Library:
             if not hy:
                 self.untested[name] = "no hyper-parameter candidate in this record"
                 continue
+            # hyper-parameters found on another record, after the record's own candidates (ties go
+            # to those): a cause found on the fitting record and refitted on the validation
+            # record's blocks keeps the value it was found at, which the blocks' own candidates
+            # may miss (reporting67 d0600: a 2.54 mm cogging, found at 2.56 mm on a 10.3 mm
+            # stroke; the blocks, 3.3 mm, hold 1.3 periods of it and their candidates end at
+            # 2.31 mm, or with the longest-wavelength candidate dropped at 1.16 mm, and a level
+            # asymmetry took its place)
+            hy = list(hy) + [h for h in (known or {}).get(name, ()) if h and h not in hy]
             self.variants[name] = [self.variant(name, h) for h in hy]
             if getattr(mod, "REFINED_ALONE", False):
                 h = self._refined_alone(name)

@@ -19,10 +19,11 @@ METHOD_NOTE = ("force residuals are the data's less the nominal model's own on i
 
 
 def library_builder(fit: Measurement, validate: Measurement, kf: Kinematics, kv: Kinematics, model: NominalModel,
-                     window: float, alpha: float, notes: list | None):
+                     window: float, alpha: float, notes: list | None, known: dict | None = None):
     """names -> Library: the force channel's library on two records with their kinematics (used
     samples marked), the saturation the records show, the instrument trajectories and the
-    estimation's error (said in ``notes`` unless None)."""
+    estimation's error (said in ``notes`` unless None); known : {cause: [hyper-parameters]} found
+    on another record, variants beside the record's own candidates (:class:`~hunting.diagnose.force.Library`)."""
     from .force import Library
     from .method_error import method_error
     from .resimulate import side_by_side
@@ -39,7 +40,7 @@ def library_builder(fit: Measurement, validate: Measurement, kf: Kinematics, kv:
             else None)
     if notes is not None and any(e is not None for e in errors):
         notes.append(METHOD_NOTE.format(*(("not formed" if e is None else f"{e.rms:.3g} N RMS") for e in errors)))
-    return lambda names: Library(names, kf, kv, model, kf.moving, kv.moving, step, kr, inst, errors, kfr)
+    return lambda names: Library(names, kf, kv, model, kf.moving, kv.moving, step, kr, inst, errors, kfr, known)
 
 
 def measured_saturation(fit: Measurement, validate: Measurement, model: NominalModel, alpha: float):

@@ -74,7 +74,9 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
 
     inside: dict = {}
     candidates = list(cross) + found + mates
-    blocks_library = library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None)   # its nominal runs once
+    # its nominal runs once; the found causes keep the hyper-parameters they were found at as variants
+    blocks_library = library_builder(fit2, val2, kf2, kv2, model, w2, alpha, None,
+                                     known={c.name: [c.hyper] for c in fc["causes"]})
     for _ in range(len(cross) + 1):          # each pass removes at least one candidate or ends the loop
         inner: list = []
         judged = identified_force_channel(blocks_library, candidates, model, max_causes, alpha, min_gain,
