@@ -452,7 +452,6 @@ def plot_cycle(result, system, *, periods: int = 2, units: dict | None = None, t
     plt = _plt()
     units = {**dict(getattr(system, "units", {}) or {}), **dict(units or {})}
     T = float(result.period)
-    names = list(result.state_names)
     tr = simulate(system, result.x0_array, (0.0, periods * T), mode0=result.mode0,
                   t_eval=np.linspace(0.0, periods * T, 2000 * periods + 1), rtol=1e-10, atol=1e-13)
     panels = cycle_panels(result, system, model, block_states=block_states)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import hunting
-from hunting import find_cycle, follow, preset
+from hunting import find_cycle, follow
 from hunting.cli import main
 from hunting.continuation import OrbitStatus, continue_orbit, resolve, shoot
 from hunting.continuation.shooting import minimal_period

@@ -9,7 +9,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scipy import stats
 
 from hunting.diagnose import NominalModel, diagnose
 from hunting.diagnose.causes.saturation import p_value, pile_up
