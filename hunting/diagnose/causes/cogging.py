@@ -68,7 +68,8 @@ def hypers(kin, model) -> list:
     force residual less its fit by the friction curve's error terms (:func:`curve_terms`;
     averaged in position bins) against position (wavelengths from 20 samples'
     travel at the slow end of the record's speeds (10th percentile) to the stroke over
-    MIN_PERIODS), and the longest of these wavelengths where the spectrum falls from it; each
+    MIN_PERIODS), and the longest of these wavelengths where the spectrum falls from it and the
+    harmonics' fit has its minimum inside the +-3 % grid around it; each
     refined on a +-3 % grid of the binned residual, then on the cause's filtered design
     (:func:`_refined`). Where two of the three peaks lie within SIDEBANDS of each other, their
     midpoint too, refined on the filtered design alone: a cogging whose amplitude in the
