@@ -451,6 +451,20 @@ def test_small_only_marks_a_member_that_fails_only_by_its_size_on_the_sliding_sa
     assert not small_only(dict(small, p_reference=0.5), 1e-3, 0.05, 0.01)                # reference fails too
 
 
+def test_displaced_marks_a_member_that_fails_only_on_its_drop_one_gain():
+    """force.displaced: significant out of sample, along the reference and above the relevance
+    floor, failing only because the set without it predicts as well (its gain, or what it removes
+    below the precision floor) -> True; failing anything else too, or nothing -> False."""
+    from hunting.diagnose.force import displaced
+    beside = dict(p_value=1e-6, gain=-0.29, rms=0.5, rms_without=0.39, floor=1e-4, change=0.3, relevance=0.04)
+    assert displaced(beside, 1e-3, 0.05, 0.01)
+    assert displaced(dict(beside, gain=0.3, rms_without=0.50005), 1e-3, 0.05, 0.01)    # the precision floor
+    assert not displaced(dict(beside, gain=0.3, rms_without=0.8), 1e-3, 0.05, 0.01)    # it passes the rule
+    assert not displaced(dict(beside, p_value=0.5), 1e-3, 0.05, 0.01)                  # not significant too
+    assert not displaced(dict(beside, change=0.01), 1e-3, 0.05, 0.01)                  # below the relevance floor
+    assert not displaced(dict(beside, p_reference=0.5), 1e-3, 0.05, 0.01)              # reference fails too
+
+
 def test_no_cause_headline_gives_the_residual_not_a_model_that_explains_the_data():
     """A 3 N offset with only cogging searched: no cause passes, and the report says that no
     cause passed the rule with the residual's size, not that the nominal model explains the data."""

@@ -499,6 +499,37 @@ def test_validation_only_search_keeps_a_found_pitch():
     assert p["amplitude_1"] == pytest.approx(e["amplitude_1"], rel=0.05)
 
 
+def test_a_cause_displaced_by_a_partner_comes_back_in_its_place():
+    """reporting67 d0513: the Stribeck velocity 7.9 mm/s for the model's 5.7, the fitting record
+    sliding up to 1.3 mm/s (where the change is a small viscous-like slope), the validation record
+    to 6.5. On the validation record's blocks the best set held the Stribeck change beside a
+    viscous one; beside it the Stribeck change's drop-one gain was -29 % and it was dropped for
+    good, and the viscous change (b 57 -> 98 N s/m) was named, although alone the Stribeck change
+    fits the blocks better (BIC -9) and predicts the others as well (84 % against 82 %). A cause
+    displaced only by a partner may come back as a rival in its place (force.displaced): the
+    Stribeck change is named, its static level within 2 %, and no viscous change."""
+    fit, val, model, truth = _dataset("reporting67", 513)
+    e = truth["effects"][0]["params"]
+    d = diagnose(fit, model, val, behaviour=False)
+    names = [c.name for c in d.causes]
+    assert names[:1] == ["stribeck"], [(c.name, c.parameters) for c in d.causes]
+    assert "viscous" not in names
+    assert d.causes[0].parameters["Fs"] == pytest.approx(e["Fs"], rel=0.02)
+
+
+def test_a_mass_change_only_the_validation_record_accelerates_enough_to_show_is_found():
+    """reporting65 d0501: the mass 12 % high, the fitting record creeping at 2.6 mm/s^2 RMS, the
+    validation record accelerating at 0.11 m/s^2. On the fitting record the change's BIC was +4.7
+    and nothing was judged; it removes 87 % of the validation residual. As a cause only the
+    validation record can show (mass.unseen: its acceleration more than 3 times the fitting
+    record's) it is searched on that record's blocks: named, within 3 %."""
+    fit, val, model, truth = _dataset("reporting65", 501)
+    e = truth["effects"][0]["params"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["mass"], [(c.name, c.parameters) for c in d.causes]
+    assert d.causes[0].parameters["mass"] == pytest.approx(e["mass"], rel=0.03)
+
+
 def test_curve_terms_remove_a_friction_curve_error_and_keep_a_periodic_force():
     """cogging._without_curve on a known residual: a level, a viscous and a Stribeck error per
     direction (of widths other than the basis's) leave less than 2 % of their RMS; a periodic force
