@@ -714,14 +714,15 @@ def small_only(t: dict, alpha: float, min_gain: float, alpha_reference: float) -
 
 
 def displaced(t: dict, alpha: float, min_gain: float, alpha_reference: float) -> bool:
-    """Whether a member's tests (:func:`_tests`) in a set of two or more fail the rule only on its
+    """Whether a member's tests (:func:`_tests`) fail the rule only on its
     drop-one gain (the set refitted without it predicts the validation data as well or better):
     significant out of sample, along the reference trajectory and above the relevance floor, its
     part taken up by a partner whose signature it shares. Such a cause is no explanation beside
     that partner, but may be one in its place (:func:`_rival`; reporting67 d0513, a Stribeck
     velocity 7.9 mm/s for the model's 5.7, on the validation record's blocks: beside a viscous
     change its drop-one gain was -29 %, alone it explains 84 % of the residual against the viscous
-    change's 82 %, and the viscous change, b 57 -> 162 N s/m, was named)."""
+    change's 82 %, and a viscous change was named, b 57 -> 98 N s/m; 162 on the blocks). The
+    caller asks it only of a member of a set of two or more: alone, a cause has no partner."""
     return _fails(t, alpha, min_gain, alpha_reference) and not _fails(
         dict(t, gain=np.inf, rms_without=np.inf), alpha, min_gain, alpha_reference)
 
