@@ -73,7 +73,8 @@ FAMILIES = {"tuning": 1, "reporting": 2, "test": 3, "tuning-level": 4, "reportin
             "reporting66": 70,
             "reporting67": 71,
             "reporting68": 72,
-            "reporting69": 73}
+            "reporting69": 73,
+            "reporting70": 74}
 # (clean, single effect, two effects)
 SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0), "tuning-level": (0, 24, 0),
          "reporting2": (120, 224, 112), "reporting3": (120, 224, 112),
@@ -114,7 +115,8 @@ SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10,
          "reporting66": (300, 224, 112),
          "reporting67": (300, 224, 112),
          "reporting68": (300, 224, 112),
-         "reporting69": (300, 224, 112)}
+         "reporting69": (300, 224, 112),
+         "reporting70": (300, 224, 112)}
 # the causes each family draws its effects from (the families drawn before ``level`` existed keep
 # their list: their datasets are a function of it)
 FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.CAUSES, "tuning-level": ("level",),
@@ -156,7 +158,8 @@ FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.C
                  "reporting66": draw.ALL_CAUSES,
                  "reporting67": draw.ALL_CAUSES,
                  "reporting68": draw.ALL_CAUSES,
-                 "reporting69": draw.ALL_CAUSES}
+                 "reporting69": draw.ALL_CAUSES,
+                 "reporting70": draw.ALL_CAUSES}
 # the tests' subset: short records, the strong half of the size range, ten causes
 SHORT = ("test",)
 TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
