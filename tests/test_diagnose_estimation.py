@@ -517,6 +517,44 @@ def test_a_cause_displaced_by_a_partner_comes_back_in_its_place():
     assert d.causes[0].parameters["Fs"] == pytest.approx(e["Fs"], rel=0.02)
 
 
+def test_a_mass_change_only_the_validation_record_accelerates_enough_to_show_is_found():
+    """reporting65 d0501: the mass 12 % high, the fitting record creeping at 2.6 mm/s^2 RMS, the
+    validation record accelerating at 0.11 m/s^2. On the fitting record the change's BIC was +4.7
+    and nothing was judged; it removes 87 % of the validation residual. As a cause only the
+    validation record can show (mass.unseen: its acceleration more than 3 times the fitting
+    record's) it is searched on that record's blocks: named, within 3 %."""
+    fit, val, model, truth = _dataset("reporting65", 501)
+    e = truth["effects"][0]["params"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert [c.name for c in d.causes] == ["mass"], [(c.name, c.parameters) for c in d.causes]
+    assert d.causes[0].parameters["mass"] == pytest.approx(e["mass"], rel=0.03)
+
+
+def test_a_small_mass_change_only_the_validation_blocks_show_is_not_named():
+    """reporting67 d0291, clean: the validation record accelerates 6.8 times harder than the
+    fitting record, and its blocks read the mass 2.3 % high at 4.6 standard uncertainties, which
+    removed 38 % of their residual. A change that small is the estimation's own on such a record
+    (mass.MIN_CHANGE_SHARE): nothing is named, and the mass row says why."""
+    fit, val, model, truth = _dataset("reporting67", 291)
+    assert not truth["effects"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == [], [(c.name, c.parameters) for c in d.causes]
+    assert any(r["name"] == "mass" and "estimation's own error" in r["reason"] for r in d.rejected), d.rejected
+
+
+def test_mass_unresolved_needs_a_change_beyond_its_uncertainty_and_the_floor():
+    """mass.unresolved on a 1 kg model: 5 % at 2.5 sigma is resolved; 5 % at 1.5 sigma is not
+    (the uncertainty); 2 % at 20 sigma is not (the floor); a missing sigma is not."""
+    from types import SimpleNamespace
+    from hunting.diagnose.causes import mass
+    model = SimpleNamespace(mass=1.0)
+    found = lambda m, s: SimpleNamespace(parameters={"mass": m}, sigma={} if s is None else {"mass": s})  # noqa: E731
+    assert mass.unresolved(found(1.05, 0.02), model) is None
+    assert "uncertainty" in mass.unresolved(found(0.95, 0.0334), model)
+    assert "estimation's own error" in mass.unresolved(found(1.02, 0.001), model)
+    assert mass.unresolved(found(1.05, None), model) is not None
+
+
 def test_curve_terms_remove_a_friction_curve_error_and_keep_a_periodic_force():
     """cogging._without_curve on a known residual: a level, a viscous and a Stribeck error per
     direction (of widths other than the basis's) leave less than 2 % of their RMS; a periodic force

@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .causes import CAUSES, seen, unseen, untestable
+from .causes import CAUSES, seen, unresolved, unseen, untestable
 from .data import Measurement
 from .force_channel import force_change, identified_force_channel, library_builder
 from .kinematics import Kinematics
@@ -144,6 +144,16 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
             kept |= set(lost)
     if joint is None and kept:
         joint = _joint_values(found, [n for n in searched if n in kept], parts, model, rule)
+    # a cross cause the blocks cannot tell from their own spread (its ``unresolved`` hook on the
+    # widened uncertainties) is searched for no more: the search runs again without it
+    final = joint[0] if joint is not None else {c.name: c for c in fc2["causes"]}
+    weak = {n: why for n in searched if n in final and (why := unresolved(n, final[n], ext))}
+    if weak:
+        out = search(fc, [n for n in names if n not in weak], model, validate, kf, kv, sensor, window, rule,
+                     untested, notes)
+        said = f" (fitted on alternate blocks of {validate.name}, judged on the others)"
+        rows = [dict(name=n, step="identification", reason=why + said) for n, why in weak.items()]
+        return dict(out, rejected=_partly_rows(out["rejected"], rows, weak, set()))
     fc2["rejected"] = [r for r in judged["rejected"] if r["name"] in cross and r["name"] not in kept] + [
         r for r in fc2["rejected"] if r["name"] in cross]
     fc2["rejected"] += [dict(name=n, step="refit", reason="it does not hold on top of the causes found on the fitting "

@@ -97,4 +97,12 @@ def seen(name: str, hyper: dict, kf, model, parameters: dict | None = None) -> s
     return _hook(name, "seen", hyper, kf, model, parameters or {})
 
 
-__all__ = ["CAUSES", "hyper_count", "hyper_keys", "seen", "unseen", "untestable"]
+def unresolved(name: str, cause, model) -> str | None:
+    """Why cause ``name``, found where only the validation record can show it (:func:`unseen`),
+    is not resolved there: its ``unresolved`` hook, called with the found Cause (final parameters,
+    their standard uncertainties widened by the spread between the validation record's blocks)
+    and the model it extends, or None where it is resolved or the cause has no such hook."""
+    return _hook(name, "unresolved", cause, model)
+
+
+__all__ = ["CAUSES", "hyper_count", "hyper_keys", "seen", "unresolved", "unseen", "untestable"]
