@@ -26,7 +26,8 @@ SHADOW_REASON = ("found on the fitting data, which cannot show {cross}; searched
 
 
 def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kinematics, kv: Kinematics,
-           sensor: dict, window: float | None, rule: tuple, untested: list, notes: list) -> dict:
+           sensor: dict, window: float | None, rule: tuple, untested: list, notes: list,
+           unresolved_here: frozenset = frozenset()) -> dict:
     """The force channel's result with the causes only the validation record can show: those
     ``untestable`` on the fitting record (it moves one way only, it has no band to see a
     resonance in) or partly ``unseen`` there (a resonance above its band, a cogging pitch longer
@@ -37,15 +38,19 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     fitting record sliding one way, where a level is an offset, left untested), and so is a cause
     of their family that ``NESTS`` one of them when the blocks choose it. Their rows in
     ``untested`` are replaced by what that search says. fc is returned unchanged when there are
-    none or the parts are not :func:`~hunting.diagnose.parts.informative`."""
+    none or the parts are not :func:`~hunting.diagnose.parts.informative`. A cross cause whose
+    value the blocks do not resolve (its ``unresolved`` hook) is searched no more: the search runs
+    again with it in ``unresolved_here``, where it is no cross cause but stays a candidate of its
+    family (a mate), as it is without its ``unseen`` hook."""
     ext = fc["model"]
     found = [c.name for c in fc["causes"]]
     blind = {n: untestable(n, kf, ext) for n in names}
     # a cause the fitting record can test in part: only a value beyond that part is the
     # validation record's to show (``seen``)
-    partly = {n: why for n in names if not blind[n] and n not in found and (why := unseen(n, kf, kv, ext))}
+    partly = {n: why for n in names if not blind[n] and n not in found and n not in unresolved_here
+              and (why := unseen(n, kf, kv, ext))}
     reasons = {n: blind[n] or partly.get(n) for n in names}
-    cross = {n: r for n, r in reasons.items() if r and not untestable(n, kv, ext)}
+    cross = {n: r for n, r in reasons.items() if r and n not in unresolved_here and not untestable(n, kv, ext)}
     parts = interleaved(validate, ext, sensor, window) if cross else None
     if parts is None:
         return fc
@@ -145,12 +150,12 @@ def search(fc: dict, names, model: NominalModel, validate: Measurement, kf: Kine
     if joint is None and kept:
         joint = _joint_values(found, [n for n in searched if n in kept], parts, model, rule)
     # a cross cause the blocks cannot tell from their own spread (its ``unresolved`` hook on the
-    # widened uncertainties) is searched for no more: the search runs again without it
+    # widened uncertainties) is searched for no more: the search runs again without it as a cross cause
     final = joint[0] if joint is not None else {c.name: c for c in fc2["causes"]}
-    weak = {n: why for n in searched if n in final and (why := unresolved(n, final[n], ext))}
-    if weak:
-        out = search(fc, [n for n in names if n not in weak], model, validate, kf, kv, sensor, window, rule,
-                     untested, notes)
+    weak = {n: why for n in cross if n in final and (why := unresolved(n, final[n], ext))}
+    if weak:       # cross excludes unresolved_here, which each call extends: at most len(names) + 1 calls
+        out = search(fc, names, model, validate, kf, kv, sensor, window, rule, untested, notes,
+                     unresolved_here | frozenset(weak))
         said = f" (fitted on alternate blocks of {validate.name}, judged on the others)"
         rows = [dict(name=n, step="identification", reason=why + said) for n, why in weak.items()]
         return dict(out, rejected=_partly_rows(out["rejected"], rows, weak, set()))

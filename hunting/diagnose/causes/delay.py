@@ -7,6 +7,7 @@ enough."""
 
 import numpy as np
 
+from ._fitting_share import shown_on_fitting_record
 from ._words import _q
 
 NAME = "delay"
@@ -22,14 +23,6 @@ UNITS = {"delay": "s"}
 # the validation record's drive-force rate over the fitting record's beyond which a delay is the
 # validation record's to show (:func:`unseen`; stribeck's, cogging's and flexibility's factor)
 UNSEEN_FACTOR = 3.0
-# the share of the fitting record's residual RMS a delay's force there must reach for that record
-# to show it (:func:`seen`): a record whose residual holds a force of RMS f has a residual of RMS
-# at least f wherever the rest is uncorrelated with it, so a delay whose force exceeds the whole
-# residual is not in that record. At the rule's min_gain share (0.33: explained, it removes 5 %
-# of the residual's RMS) a delay beside a cause of its signature's family was lost (reporting62
-# d0569: 0.24 ms beside a Stribeck change, its force on the fitting record 0.64 times that
-# record's residual, read there as a viscous change)
-SEEN_SHARE = 1.0
 
 
 def hypers(kin, model) -> list:
@@ -49,22 +42,14 @@ def drive_rate(kin, model) -> float:
 def seen(hyper, kf, model, parameters) -> str | None:
     """Why a delay found on the validation record alone (:func:`unseen`) is one the fitting record
     (``kf``, its used samples marked) would show, where it showed none: its force there, the delay
-    (``parameters["delay"]`` less the model's own) times that record's drive rate, reaches SEEN_SHARE of that
-    record's force residual against ``model`` (RMS on its used samples; reporting62 d0046, clean:
-    a 0.16 ms "delay" on the validation record's blocks whose force on the fitting record, 29 mN,
+    (``parameters["delay"]`` less the model's own) times that record's drive rate, reaches
+    SEEN_SHARE (:mod:`._fitting_share`) of that record's force residual against ``model`` (RMS on
+    its used samples; reporting62 d0046, clean: a 0.16 ms "delay" on the validation record's
+    blocks whose force on the fitting record, 29 mN,
     is 1.6 times that record's residual; the true delays found there, reporting63 d0432 and
     reporting62 d0569, 0.23 and 0.64 times)."""
-    from ..kinematics import residual
-    used = kf.moving
-    if not used.any():
-        return None
-    rms = float(np.sqrt(np.mean(residual(kf, model)[used] ** 2)))
     force = abs(float(parameters["delay"]) - model.delay) * drive_rate(kf, model)
-    if not (rms > 0 and force >= SEEN_SHARE * rms):
-        return None
-    return (f"its force on the fitting record ({_q(force, None, 'N')} RMS, the delay times that record's drive "
-            f"force rate) is {force / rms:.2g} times that record's residual ({_q(rms, None, 'N')} RMS): that record "
-            "would show it, and showed none")
+    return shown_on_fitting_record(kf, model, force, "the delay times that record's drive force rate")
 
 
 def unseen(kf, kv, model) -> str | None:

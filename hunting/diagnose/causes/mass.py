@@ -1,6 +1,7 @@
 """A wrong mass (or inertia)."""
 import numpy as np
 
+from ._fitting_share import shown_on_fitting_record
 from ._words import _pct, _q
 
 NAME = "mass"
@@ -16,10 +17,6 @@ UNITS = {"mass": "kg"}
 # is the validation record's to show (:func:`unseen`): the factor of delay's drive rate, cogging's
 # stroke and flexibility's band (their UNSEEN_FACTOR)
 UNSEEN_FACTOR = 3.0
-# the share of the fitting record's residual RMS a mass change's force there must reach for that
-# record to show it (:func:`seen`; delay's SEEN_SHARE, the same argument: a force larger than the
-# whole residual is not in that record)
-SEEN_SHARE = 1.0
 
 
 def hypers(kin, model) -> list:
@@ -50,19 +47,10 @@ def unseen(kf, kv, model) -> str | None:
 def seen(hyper, kf, model, parameters) -> str | None:
     """Why a mass change found on the validation record alone (:func:`unseen`) is one the fitting
     record (``kf``, its used samples marked) would show, where it showed none: its force there,
-    the change times that record's acceleration RMS, reaches SEEN_SHARE of that record's force
-    residual against ``model`` (RMS on its used samples)."""
-    from ..kinematics import residual
-    used = kf.moving & np.isfinite(kf.a)
-    if not used.any():
-        return None
-    rms = float(np.sqrt(np.mean(residual(kf, model)[used] ** 2)))
+    the change times that record's acceleration RMS, reaches SEEN_SHARE (:mod:`._fitting_share`;
+    delay's argument) of that record's force residual against ``model`` (RMS on its used samples)."""
     force = abs(float(parameters["mass"]) - model.mass) * acceleration_rms(kf)
-    if not (rms > 0 and force >= SEEN_SHARE * rms):
-        return None
-    return (f"its force on the fitting record ({_q(force, None, 'N')} RMS, the change times that record's "
-            f"acceleration) is {force / rms:.2g} times that record's residual ({_q(rms, None, 'N')} RMS): that "
-            "record would show it, and showed none")
+    return shown_on_fitting_record(kf, model, force, "the change times that record's acceleration")
 
 
 # a mass change found on the validation record alone must lie this many standard uncertainties
@@ -90,7 +78,9 @@ def unresolved(cause, model) -> str | None:
         return (f"the mass change it finds there ({_pct(abs(change) / model.mass)} of the model's mass) is smaller "
                 f"than the {_pct(MIN_CHANGE_SHARE)} the estimation's own error reaches on a record that accelerates "
                 "that hard")
-    if np.isfinite(sigma) and abs(change) >= MIN_CHANGE_Z * sigma:
+    if not np.isfinite(sigma):
+        return f"the mass change it finds there ({_q(change, None, 'kg')}) has no stated uncertainty"
+    if abs(change) >= MIN_CHANGE_Z * sigma:
         return None
     return (f"the mass change it finds there ({_q(change, None, 'kg')}) lies within {MIN_CHANGE_Z:g} of its "
             f"uncertainty ({_q(sigma, None, 'kg')}, the spread between that record's blocks): that record does not "
