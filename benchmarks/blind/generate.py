@@ -74,7 +74,8 @@ FAMILIES = {"tuning": 1, "reporting": 2, "test": 3, "tuning-level": 4, "reportin
             "reporting67": 71,
             "reporting68": 72,
             "reporting69": 73,
-            "reporting70": 74}
+            "reporting70": 74,
+            "reporting71": 75}
 # (clean, single effect, two effects)
 SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10, 0), "tuning-level": (0, 24, 0),
          "reporting2": (120, 224, 112), "reporting3": (120, 224, 112),
@@ -116,7 +117,8 @@ SIZES = {"tuning": (60, 130, 52), "reporting": (120, 208, 104), "test": (10, 10,
          "reporting67": (300, 224, 112),
          "reporting68": (300, 224, 112),
          "reporting69": (300, 224, 112),
-         "reporting70": (300, 224, 112)}
+         "reporting70": (300, 224, 112),
+         "reporting71": (300, 224, 112)}
 # the causes each family draws its effects from (the families drawn before ``level`` existed keep
 # their list: their datasets are a function of it)
 FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.CAUSES, "tuning-level": ("level",),
@@ -159,7 +161,8 @@ FAMILY_CAUSES = {"tuning": draw.CAUSES, "reporting": draw.CAUSES, "test": draw.C
                  "reporting67": draw.ALL_CAUSES,
                  "reporting68": draw.ALL_CAUSES,
                  "reporting69": draw.ALL_CAUSES,
-                 "reporting70": draw.ALL_CAUSES}
+                 "reporting70": draw.ALL_CAUSES,
+                 "reporting71": draw.ALL_CAUSES}
 # the tests' subset: short records, the strong half of the size range, ten causes
 SHORT = ("test",)
 TEST_CAUSES = ("offset", "asymmetry", "cogging", "stribeck", "viscous", "mass", "delay", "lag", "reversal",
