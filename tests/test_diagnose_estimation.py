@@ -466,6 +466,32 @@ def test_cogging_pitch_is_found(family, index, pitch_rel):
     assert p["amplitude_1"] == pytest.approx(e["amplitude_1"], rel=0.05)
 
 
+def test_cogging_ripple_below_the_relevance_floor_is_no_cause():
+    """cogging.unidentified on a model of Coulomb level 2 N (floor 0.3 %: 6 mN): a new ripple of
+    5 mN RMS is no cause, one of 8 mN is; a change of a cogging the model has at that pitch is
+    not judged by the floor (moving the model's harmonics is part of it)."""
+    from hunting.diagnose import NominalModel
+    from hunting.diagnose.causes import cogging
+    from hunting.models.plant import Cogging
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"law": "coulomb-viscous", "Fc": 2.0}})
+    ripple = lambda r: [r, 0.0, 0.0, 0.0, 0.0, 0.0]  # noqa: E731  (a first harmonic of RMS r/sqrt(2))
+    assert "below 0.3%" in cogging.unidentified({"pitch": 1e-3}, {}, model=model, theta=ripple(5e-3 * 2 ** 0.5))
+    assert cogging.unidentified({"pitch": 1e-3}, {}, model=model, theta=ripple(8e-3 * 2 ** 0.5)) is None
+    known = model.replace(cogging=(Cogging.harmonic(1.0e-3, [0.5], [0.0]),))
+    assert cogging.unidentified({"pitch": 1.01e-3}, {}, model=known, theta=ripple(1e-4)) is None
+
+
+def test_clean_record_names_no_ripple_below_the_floor():
+    """reporting70 d0214, clean: the pitch search read through 31 samples found a 4.1 mm ripple of
+    3.6 mN RMS (0.13 % of the 2.75 N Coulomb level) that passed its test (p = 3e-4, validation
+    gain 8 %). Below the relevance floor it is no cause: nothing is named, and its row says why."""
+    fit, val, model, truth = _dataset("reporting70", 214)
+    assert not truth["effects"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert d.causes == [], [(c.name, c.parameters) for c in d.causes]
+    assert any(r["name"] == "cogging" and "ripple" in r["reason"] for r in d.rejected), d.rejected
+
+
 def test_cogging_pitch_beside_a_friction_curve_change():
     """reporting66 d0546: a 5.56 mm cogging (1.86 N) beside a Stribeck change (Fs 16.9 -> 19.8 N),
     the validation record's stroke 11 periods from the fitting record's. Searched on the nominal

@@ -75,8 +75,9 @@ def _rms(r) -> float:
 
 def identified_force_channel(library, names, model, max_causes, alpha, min_gain, alpha_reference, untested) -> dict:
     """The force channel's result (:func:`force_channel_result`) with every selected cause identified:
-    a cause whose ``unidentified(parameters, sigma)`` hook gives a reason (its fitted parameters do
-    not single it out, e.g. a reversal scale within two standard uncertainties of zero) is taken
+    a cause whose ``unidentified(parameters, sigma, model=, theta=)`` hook gives a reason (its fitted
+    parameters do not single it out, e.g. a reversal scale within two standard uncertainties of
+    zero, or a new cogging ripple below the friction force's relevance floor) is taken
     out of the library and the channel judged again without it; each such cause gets a rejected
     row (step "identification") ahead of the others. library(names) builds the Library; the
     untested causes of the first one are appended to ``untested``. At most len(names) + 1 passes:
@@ -89,7 +90,8 @@ def identified_force_channel(library, names, model, max_causes, alpha, min_gain,
         if not excluded:
             untested += [dict(name=k, reason=v) for k, v in lib.untested.items()]
         fc = force_channel_result(lib, model, select(lib, max_causes, alpha, min_gain, alpha_reference), min_gain)
-        fails = [(c, getattr(CAUSES[c.name], "unidentified", lambda *a: None)(c.parameters, c.sigma))
+        fails = [(c, getattr(CAUSES[c.name], "unidentified", lambda *a, **k: None)(c.parameters, c.sigma, model=lib.model,
+                                                                                    theta=c.theta))
                  for c in fc["causes"]]
         fails = [(c, why) for c, why in fails if why]
         if not fails:

@@ -233,6 +233,27 @@ def _harmonics(q, pitch):
     return np.column_stack(cols)
 
 
+def unidentified(p, sig, model=None, theta=None) -> str | None:
+    """Why a selected cogging is no cause (None when it is): a new ripple (the model has none of
+    about its pitch) whose RMS over a period, sqrt(sum of the fitted coefficients squared / 2), is
+    below the friction force's relevance floor (:data:`~hunting.diagnose.force.RELEVANCE` of the
+    mean Coulomb level). Friction is neither known nor steady along a stroke to better than that,
+    and the force channel sizes the friction force's own changes against the same floor; a
+    position ripple is measured in the same newtons. On reporting70 d0214 (clean, a 4.1 mm pitch
+    from the spectrum read through 31 samples) a ripple of 0.13 % of Fc passed its test at
+    p = 3e-4 with a validation gain of 8 %; the smallest true cogging named on that set was 0.8 %
+    (d0533), the generator's smallest amplitude 1 %."""
+    if model is None or theta is None or matched(model, p["pitch"]) is not None:
+        return None
+    from ..force import RELEVANCE
+    ripple = float(np.sqrt(np.sum(np.asarray(theta, float) ** 2) / 2.0))
+    Fc = 0.5 * (abs(model.curve.positive.Fc) + abs(model.curve.negative.Fc))
+    if ripple >= RELEVANCE * Fc:
+        return None
+    return (f"its ripple, {_q(ripple, None, 'N')} RMS, is below {RELEVANCE:.1%} of the mean Coulomb level "
+            f"({_q(Fc, None, 'N')}): friction is neither known nor steady along the stroke to better than that")
+
+
 def untestable(kin, model) -> str | None:
     if kin.moving.sum() < 50:
         return "fewer than 50 sliding samples"

@@ -163,7 +163,7 @@ def _slip(hyper, model) -> float:
 MIN_SCALE_Z = 2.0     # a reversal's scale must be this many standard uncertainties from zero
 
 
-def unidentified(p, sig) -> str | None:
+def unidentified(p, sig, model=None, theta=None) -> str | None:
     """Why a selected reversal is not identified (None when it is): its ``scale``, re-estimated at
     the refined sigma0 and damping (those of the extension, which builds up the whole level),
     outside SCALE_RANGE, or within MIN_SCALE_Z standard uncertainties of zero.
