@@ -481,6 +481,35 @@ def test_cogging_ripple_below_the_relevance_floor_is_no_cause():
     assert cogging.unidentified({"pitch": 1.01e-3}, {}, model=known, theta=ripple(1e-4)) is None
 
 
+def test_cogging_variant_whose_harmonics_repeat_sooner_is_not_its_pitch():
+    """cogging.unphysical: harmonics that all sit at multiples of 3 (or 2) of a variant's
+    fundamental make a ripple of a third (half) of its pitch; a fundamental holding 5 % of the
+    power (above SUBPERIOD_SHARE) keeps the variant."""
+    from hunting.diagnose import NominalModel
+    from hunting.diagnose.causes import cogging
+    model = NominalModel.from_dict({"plant": {"mass": 1.0}, "friction": {"law": "coulomb-viscous", "Fc": 2.0}})
+    third = [0.01, 0.0, 0.0, 0.0, 1.0, 0.5]
+    assert "pitch / 3" in cogging.unphysical(third, {"pitch": 3e-3}, model)
+    assert "pitch / 2" in cogging.unphysical([0.0, 0.01, 0.8, 0.0, 0.0, 0.0], {"pitch": 2e-3}, model)
+    assert cogging.unphysical([0.25, 0.0, 0.0, 0.0, 1.0, 0.0], {"pitch": 3e-3}, model) is None
+    assert cogging.unphysical([1.0, 0.0, 0.3, 0.0, 0.2, 0.0], {"pitch": 1e-3}, model) is None
+
+
+def test_cogging_beside_a_delay_at_its_own_pitch():
+    """reporting70 d0545: a 2.778 mm cogging (19 N) beside a 1.46 ms delay. Read through the short
+    window the candidates were 1.89, 2.766 and 8.311 mm, and the last, three times the pitch, fitted
+    the cogging as its third harmonic better than the second did as its first: named at 8.31 mm,
+    its first amplitude 99 % low. Such a variant is not a cogging of its pitch: the cogging is
+    named at its own pitch (within 0.2 %) beside the delay."""
+    fit, val, model, truth = _dataset("reporting70", 545)
+    e = next(x for x in truth["effects"] if x["cause"] == "cogging")["params"]
+    d = diagnose(fit, model, val, behaviour=False)
+    assert sorted(c.name for c in d.causes) == ["cogging", "delay"], [(c.name, c.parameters) for c in d.causes]
+    p = next(c for c in d.causes if c.name == "cogging").parameters
+    assert p["pitch"] == pytest.approx(e["pitch"], rel=2e-3)
+    assert p["amplitude_1"] == pytest.approx(e["amplitude_1"], rel=0.05)
+
+
 def test_clean_record_names_no_ripple_below_the_floor():
     """reporting70 d0214, clean: the pitch search read through 31 samples found a 4.1 mm ripple of
     3.6 mN RMS (0.13 % of the 2.75 N Coulomb level) that passed its test (p = 3e-4, validation

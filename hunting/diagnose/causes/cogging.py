@@ -37,6 +37,7 @@ UNSEEN_FACTOR = 3.0
 # edge, 11 periods away the validation record's phase was 40 degrees off and the cogging
 # predicted it 6 % worse; fitted beside the curve terms, +0.2 % and a valley 100 times deeper)
 CURVE_DIPS = 4
+SUBPERIOD_SHARE = 0.01  # a variant whose harmonics off a multiple k hold less than this share: period pitch / k
 SPECTRUM_WINDOW = 31  # [samples] the pitch search's smoothing window at most (:func:`spectrum_kinematics`)
 
 
@@ -231,6 +232,27 @@ def _harmonics(q, pitch):
         w = 2 * np.pi * k / pitch
         cols += [np.cos(w * q), np.sin(w * q)]
     return np.column_stack(cols)
+
+
+def unphysical(theta, hyper, model) -> str | None:
+    """Why a fitted variant is not a cogging of its pitch (None when it is): its merged harmonics
+    (:func:`merged`) repeat every pitch / k (k = 2 or 3; the harmonics that are no multiple of k
+    hold less than SUBPERIOD_SHARE of their square sum), so the force's period is that, a
+    candidate of its own; read at k times it, the fundamental and its first harmonics are
+    missing. reporting70 d0545 (a 2.778 mm cogging beside a delay): the candidate at three times
+    the pitch, 8.311 mm, fitted the cogging as its third harmonic (0.01 % of the square sum in the
+    other two) and was chosen over the 2.766 mm candidate."""
+    c = merged(theta, hyper, model)
+    power = c[0::2] ** 2 + c[1::2] ** 2              # per harmonic 1..HARMONICS
+    total = float(power.sum())
+    if not total > 0:
+        return None
+    for k in (2, 3):
+        other = float(sum(power[i] for i in range(HARMONICS) if (i + 1) % k))
+        if other < SUBPERIOD_SHARE * total:
+            return (f"its harmonics repeat every pitch / {k} ({_q(hyper['pitch'] / k, None, 'm')}; "
+                    f"{other / total:.2%} of their power at the others): the ripple's period is that")
+    return None
 
 
 def unidentified(p, sig, model=None, theta=None) -> str | None:
