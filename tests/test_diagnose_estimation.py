@@ -479,6 +479,12 @@ def test_cogging_ripple_below_the_relevance_floor_is_no_cause():
     assert cogging.unidentified({"pitch": 1e-3}, {}, model=model, theta=ripple(8e-3 * 2 ** 0.5)) is None
     known = model.replace(cogging=(Cogging.harmonic(1.0e-3, [0.5], [0.0]),))
     assert cogging.unidentified({"pitch": 1.01e-3}, {}, model=known, theta=ripple(1e-4)) is None
+    # three harmonics, their RMS taken numerically over a period, scaled to 1 % either side of the floor
+    theta = np.array([0.3, -0.2, 0.15, 0.1, -0.05, 0.12])
+    q = np.linspace(0.0, 1e-3, 20001)[:-1]
+    rms = float(np.sqrt(np.mean((cogging._harmonics(q, 1e-3) @ theta) ** 2)))
+    assert "below" in cogging.unidentified({"pitch": 1e-3}, {}, model=model, theta=theta * 0.99 * 6e-3 / rms)
+    assert cogging.unidentified({"pitch": 1e-3}, {}, model=model, theta=theta * 1.01 * 6e-3 / rms) is None
 
 
 def test_cogging_variant_whose_harmonics_repeat_sooner_is_not_its_pitch():

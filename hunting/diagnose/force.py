@@ -843,11 +843,18 @@ def relevance_floor(model: NominalModel, name: str) -> float:
     ``model`` (the model the force channel extends: the nominal one, or its extension by the
     causes found on the fitting record where alternate blocks of the validation record are
     searched) for a change of the friction force's level or curve (``FRICTION_FORCE`` causes), 0 for
-    the others (dynamics, memory, ripple: their size has no common scale with the friction level; a
+    the others (dynamics, memory: their size has no common scale with the friction level; a
     true 2 ms delay of reporting20 d0306 moved a stiff servo's force by 0.35 % of Fc, a true 4.7 ms
-    lag of d0336 by 0.12 %)."""
+    lag of d0336 by 0.12 %; a ripple is held to :func:`relevance_level` on its fitted amplitudes
+    after the selection, ``cogging.unidentified``)."""
     if not getattr(CAUSES[name], "FRICTION_FORCE", False):
         return 0.0
+    return relevance_level(model)
+
+
+def relevance_level(model: NominalModel) -> float:
+    """``RELEVANCE`` times the mean of ``model``'s Coulomb levels [N]: the smallest force a
+    friction change (:func:`relevance_floor`) or a new ripple must make to be a cause."""
     return RELEVANCE * 0.5 * (abs(model.curve.positive.Fc) + abs(model.curve.negative.Fc))
 
 

@@ -267,13 +267,14 @@ def unidentified(p, sig, model=None, theta=None) -> str | None:
     (d0533), the generator's smallest amplitude 1 %."""
     if model is None or theta is None or matched(model, p["pitch"]) is not None:
         return None
-    from ..force import RELEVANCE
+    from ..force import RELEVANCE, relevance_level
     ripple = float(np.sqrt(np.sum(np.asarray(theta, float) ** 2) / 2.0))
-    Fc = 0.5 * (abs(model.curve.positive.Fc) + abs(model.curve.negative.Fc))
-    if ripple >= RELEVANCE * Fc:
+    floor = relevance_level(model)
+    if ripple >= floor:
         return None
     return (f"its ripple, {_q(ripple, None, 'N')} RMS, is below {RELEVANCE:.1%} of the mean Coulomb level "
-            f"({_q(Fc, None, 'N')}): friction is neither known nor steady along the stroke to better than that")
+            f"({_q(floor / RELEVANCE, None, 'N')}): friction is neither known nor steady along the stroke to better "
+            "than that")
 
 
 def untestable(kin, model) -> str | None:
